@@ -1,0 +1,43 @@
+# The two commands of the README: `make demo` and `make test`. Everything else is a building block.
+JOBS      ?= $(shell nproc)
+BUILD     ?= build
+ASAN      ?= build-asan
+TSAN      ?= build-tsan
+GENERATOR := $(shell command -v ninja >/dev/null 2>&1 && echo "-G Ninja")
+CTEST     := ctest --output-on-failure --timeout 600 -j $(JOBS)
+
+.PHONY: deps build test test-release test-asan test-tsan demo bench clean
+
+deps:
+	@scripts/install-deps
+
+$(BUILD)/build.ninja $(BUILD)/Makefile:
+	cmake -S . -B $(BUILD) $(GENERATOR) -DCMAKE_BUILD_TYPE=Release
+
+build: deps $(BUILD)/$(if $(GENERATOR),build.ninja,Makefile)
+	cmake --build $(BUILD) -j $(JOBS)
+
+# The whole suite: the Release build, then the ASan+UBSan build.
+test: deps test-release test-asan
+
+test-release: build
+	cd $(BUILD) && $(CTEST)
+
+test-asan: deps
+	cmake -S . -B $(ASAN) $(GENERATOR) -DCMAKE_BUILD_TYPE=Debug -DRIGCAL_SANITIZE=address
+	cmake --build $(ASAN) -j $(JOBS)
+	cd $(ASAN) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 $(CTEST)
+
+test-tsan: deps
+	cmake -S . -B $(TSAN) $(GENERATOR) -DCMAKE_BUILD_TYPE=Debug -DRIGCAL_SANITIZE=thread
+	cmake --build $(TSAN) -j $(JOBS)
+	cd $(TSAN) && TSAN_OPTIONS=halt_on_error=1 $(CTEST)
+
+demo: build
+	@scripts/demo $(BUILD)
+
+bench: build
+	@scripts/run-benchmarks $(BUILD)
+
+clean:
+	rm -rf $(BUILD) $(ASAN) $(TSAN)

@@ -1,0 +1,10 @@
+# Sanitizer builds apply to every target (ours and the test framework's main), so they are set globally.
+if(RIGCAL_SANITIZE STREQUAL "address")
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -O1 -g)
+  add_link_options(-fsanitize=address,undefined)
+elseif(RIGCAL_SANITIZE STREQUAL "thread")
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer -O1 -g)
+  add_link_options(-fsanitize=thread)
+elseif(RIGCAL_SANITIZE)
+  message(FATAL_ERROR "RIGCAL_SANITIZE must be 'address', 'thread' or empty, not '${RIGCAL_SANITIZE}'")
+endif()
