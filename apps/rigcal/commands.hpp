@@ -1,0 +1,19 @@
+#pragma once
+// Each subcommand lives in its own commands/<name>_command.cpp and adds itself to the app. A command's
+// callback reports failure by throwing CommandFailed with its exit code and one-line message.
+#include <CLI/CLI.hpp>
+
+#include <stdexcept>
+#include <string>
+
+namespace rigcal::app {
+
+struct CommandFailed : std::runtime_error {
+  CommandFailed(int exit_code, const std::string& message)
+      : std::runtime_error(message), code(exit_code) {}
+  int code;
+};
+
+void addCheckConfigCommand(CLI::App& app);
+
+}  // namespace rigcal::app

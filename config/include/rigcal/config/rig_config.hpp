@@ -1,0 +1,58 @@
+#pragma once
+// One YAML file per rig: its sensors and where their packets come from, the roles of each sensor,
+// the initial extrinsics, and the calibration parameters. See config/rigs/ for examples.
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rigcal/config/config_error.hpp"
+#include "rigcal/config/parameters.hpp"
+#include "rigcal/core/pose.hpp"
+#include "rigcal/core/time.hpp"
+
+namespace rigcal::config {
+
+/// Where a sensor's packets come from: a live UDP port, or the same port/address filter in a pcap.
+struct SensorSource {
+  std::uint16_t port = 0;
+  std::optional<std::string> address;          // the sensor's IPv4 address (source filter)
+  std::optional<std::string> multicast_group;  // live only: join this group
+};
+
+struct SensorConfig {
+  std::string name;
+  std::string model;                  // validated by the drivers when the decoder is built
+  SensorSource source;
+  std::filesystem::path calibration;  // absolute, or empty
+  std::filesystem::path metadata;     // absolute, or empty
+  TimeSource time_source = TimeSource::kSensorClock;
+  double cut_angle_deg = 0.0;
+  SourceLocation where;               // the sensor's entry, for later error messages
+};
+
+struct Roles {
+  std::string mapping_lidar;
+  std::vector<std::string> calibration_lidars;
+  std::string base_frame = "base_link";
+};
+
+struct RigConfig {
+  std::filesystem::path file;
+  std::string name;
+  std::vector<SensorConfig> sensors;
+  Roles roles;
+  std::map<std::string, Pose> initial_T_base_sensor;  // every sensor has one
+  Parameters parameters;
+  std::vector<std::string> warnings;                  // accepted but noteworthy (ignored upstream keys)
+
+  [[nodiscard]] const SensorConfig& sensor(const std::string& name) const;
+};
+
+/// Reads and validates a rig file. Relative calibration/metadata paths are resolved against the rig
+/// file's folder. Throws ConfigError (file:line:column, one line) on the first mistake.
+RigConfig loadRigConfig(const std::filesystem::path& file);
+
+}  // namespace rigcal::config

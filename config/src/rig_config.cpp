@@ -1,0 +1,288 @@
+#include "rigcal/config/rig_config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "parameter_table.hpp"
+
+namespace rigcal::config {
+
+const SensorConfig& RigConfig::sensor(const std::string& name) const {
+  for (const auto& s : sensors)
+    if (s.name == name) return s;
+  throw ConfigError({file}, "no sensor named '" + name + "'");
+}
+
+namespace {
+
+// Walks the YAML tree and turns every mistake into a ConfigError at the offending node.
+class Reader {
+ public:
+  explicit Reader(std::filesystem::path file) : file_(std::move(file)) {}
+
+  [[nodiscard]] SourceLocation at(const YAML::Node& node) const {
+    const YAML::Mark m = node.Mark();
+    if (m.is_null()) return {file_};
+    return {file_, m.line + 1, m.column + 1};
+  }
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
+    throw ConfigError(at(node), what);
+  }
+
+  void requireMap(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsMap()) fail(node, what + " must be a mapping of key: value");
+  }
+
+  /// Refuses keys outside `allowed`, naming the closest allowed one.
+  void checkKeys(const YAML::Node& map, const std::vector<std::string>& allowed,
+                 const std::string& section) const {
+    for (const auto& kv : map) {
+      const std::string key = kv.first.as<std::string>();
+      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+      std::string msg = "unknown key '" + key + "' in " + section;
+      if (const std::string near = closestName(key, allowed); !near.empty())
+        msg += " (did you mean '" + near + "'?)";
+      fail(kv.first, msg);
+    }
+  }
+
+  const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& section) const {
+    const YAML::Node n = map[key];
+    if (!n) fail(map, section + " needs '" + key + "'");
+    return n;
+  }
+
+  std::string text(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar()) fail(n, "'" + key + "' must be a string");
+    return n.as<std::string>();
+  }
+
+  double number(const YAML::Node& n, const std::string& key) const {
+    double v = 0;
+    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
+      fail(n, "'" + key + "' must be a finite number, got '" + scalarText(n) + "'");
+    return v;
+  }
+
+  long long integer(const YAML::Node& n, const std::string& key) const {
+    long long v = 0;
+    if (!n.IsScalar() || !YAML::convert<long long>::decode(n, v))
+      fail(n, "'" + key + "' must be an integer, got '" + scalarText(n) + "'");
+    return v;
+  }
+
+  bool boolean(const YAML::Node& n, const std::string& key) const {
+    bool v = false;
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
+      fail(n, "'" + key + "' must be true or false, got '" + scalarText(n) + "'");
+    return v;
+  }
+
+  void inRange(const YAML::Node& n, const std::string& key, double v, double lo, double hi) const {
+    if (v < lo || v > hi) {
+      std::ostringstream msg;
+      msg << "'" << key << "' = " << v << " is out of range; allowed [" << lo << ", " << hi << "]";
+      fail(n, msg.str());
+    }
+  }
+
+  /// A file the config refers to: resolved against the config's folder, and it must exist.
+  std::filesystem::path existingFile(const YAML::Node& n, const std::string& key) const {
+    std::filesystem::path p = text(n, key);
+    if (p.is_relative()) p = file_.parent_path() / p;
+    p = p.lexically_normal();
+    if (!std::filesystem::is_regular_file(p))
+      fail(n, key + " file '" + n.as<std::string>() + "' not found (looked for " + p.string() + ")");
+    return p;
+  }
+
+ private:
+  static std::string scalarText(const YAML::Node& n) {
+    if (n.IsScalar()) return n.Scalar();
+    return n.IsSequence() ? "a list" : n.IsMap() ? "a mapping" : "nothing";
+  }
+  std::filesystem::path file_;
+};
+
+SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
+  r.requireMap(n, "a sensor");
+  r.checkKeys(n, {"name", "model", "source", "calibration", "metadata", "time_source", "cut_angle"},
+              "sensor");
+  SensorConfig s;
+  s.where = r.at(n);
+  s.name = r.text(r.required(n, "name", "a sensor"), "name");
+  s.model = r.text(r.required(n, "model", "sensor '" + s.name + "'"), "model");
+
+  const YAML::Node src = r.required(n, "source", "sensor '" + s.name + "'");
+  r.requireMap(src, "source");
+  r.checkKeys(src, {"port", "address", "multicast_group"}, "source of sensor '" + s.name + "'");
+  const YAML::Node port = r.required(src, "port", "source of sensor '" + s.name + "'");
+  const long long p = r.integer(port, "port");
+  r.inRange(port, "port", double(p), 1, 65535);
+  s.source.port = std::uint16_t(p);
+  if (src["address"]) s.source.address = r.text(src["address"], "address");
+  if (src["multicast_group"]) s.source.multicast_group = r.text(src["multicast_group"], "multicast_group");
+
+  if (n["calibration"]) s.calibration = r.existingFile(n["calibration"], "calibration");
+  if (n["metadata"]) s.metadata = r.existingFile(n["metadata"], "metadata");
+  if (const YAML::Node ts = n["time_source"]) {
+    const std::string v = r.text(ts, "time_source");
+    if (v == "sensor")
+      s.time_source = TimeSource::kSensorClock;
+    else if (v == "host")
+      s.time_source = TimeSource::kHostReceive;
+    else
+      r.fail(ts, "'time_source' must be 'sensor' or 'host', got '" + v + "'");
+  }
+  if (const YAML::Node c = n["cut_angle"]) {
+    s.cut_angle_deg = r.number(c, "cut_angle");
+    r.inRange(c, "cut_angle", s.cut_angle_deg, 0, 360);
+  }
+  return s;
+}
+
+Pose readExtrinsic(const Reader& r, const YAML::Node& n, const std::string& sensor) {
+  r.requireMap(n, "the initial extrinsic of '" + sensor + "'");
+  const std::vector<std::string> keys = {"x", "y", "z", "roll", "pitch", "yaw"};
+  r.checkKeys(n, keys, "initial_extrinsics of '" + sensor + "'");
+  double v[6] = {};
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    if (n[keys[i]]) v[i] = r.number(n[keys[i]], keys[i]);
+  for (int i = 3; i < 6; ++i)
+    if (std::abs(v[i]) > 2 * M_PI)
+      r.fail(n[keys[std::size_t(i)]], "'" + keys[std::size_t(i)] + "' is in radians; allowed [-2π, 2π]");
+  return fromXyzRpy({v[0], v[1], v[2], v[3], v[4], v[5]});
+}
+
+void readParameters(const Reader& r, const YAML::Node& n, Parameters& params,
+                    std::vector<std::string>& warnings) {
+  r.requireMap(n, "parameters");
+  const auto& specs = detail::parameterSpecs();
+  const auto& ignored = detail::ignoredUpstreamParameters();
+  std::vector<std::string> names;
+  for (const auto& s : specs) names.push_back(s.name);
+
+  for (const auto& kv : n) {
+    const std::string key = kv.first.as<std::string>();
+    const auto spec = std::find_if(specs.begin(), specs.end(), [&](const auto& s) { return key == s.name; });
+    if (spec == specs.end()) {
+      if (std::find(ignored.begin(), ignored.end(), key) != ignored.end()) {
+        warnings.push_back(r.at(kv.first).str() + ": upstream parameter '" + key +
+                           "' is not used by rigcal; ignored");
+        continue;
+      }
+      std::string msg = "unknown parameter '" + key + "'";
+      if (const std::string near = closestName(key, names); !near.empty())
+        msg += " (did you mean '" + near + "'?)";
+      r.fail(kv.first, msg);
+    }
+    const YAML::Node& value = kv.second;
+    std::visit(
+        [&](auto member) {
+          using T = std::remove_reference_t<decltype(params.*member)>;
+          if constexpr (std::is_same_v<T, double>) {
+            const double v = r.number(value, key);
+            r.inRange(value, key, v, spec->min, spec->max);
+            params.*member = v;
+          } else if constexpr (std::is_same_v<T, int>) {
+            const long long v = r.integer(value, key);
+            r.inRange(value, key, double(v), spec->min, spec->max);
+            params.*member = int(v);
+          } else if constexpr (std::is_same_v<T, bool>) {
+            params.*member = r.boolean(value, key);
+          } else {
+            const std::string v = r.text(value, key);
+            if (std::find(spec->choices.begin(), spec->choices.end(), v) == spec->choices.end()) {
+              std::string allowed;
+              for (const auto& c : spec->choices) allowed += (allowed.empty() ? "" : ", ") + c;
+              r.fail(value, "'" + key + "' = '" + v + "' is not allowed; allowed: " + allowed);
+            }
+            params.*member = v;
+          }
+        },
+        spec->member);
+  }
+}
+
+void checkConsistency(const Reader& r, const YAML::Node& root, const RigConfig& rig) {
+  const Parameters& p = rig.parameters;
+  const YAML::Node params = root["parameters"] ? root["parameters"] : root;
+  if (p.mapping_min_range >= p.mapping_max_range)
+    r.fail(params, "mapping_min_range must be below mapping_max_range");
+  if (p.min_calibration_range >= p.max_calibration_range)
+    r.fail(params, "min_calibration_range must be below max_calibration_range");
+  if (p.lidar_calibration_min_frames > p.lidar_calibration_max_frames)
+    r.fail(params, "lidar_calibration_min_frames must not exceed lidar_calibration_max_frames");
+}
+
+}  // namespace
+
+RigConfig loadRigConfig(const std::filesystem::path& file) {
+  if (!std::filesystem::is_regular_file(file)) throw ConfigError({file}, "rig file not found");
+  const Reader r(file);
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file.string());
+  } catch (const YAML::Exception& e) {
+    throw ConfigError({file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + e.msg);
+  }
+  r.requireMap(root, "a rig file");
+  r.checkKeys(root, {"rig", "sensors", "roles", "initial_extrinsics", "parameters"}, "the rig file");
+
+  RigConfig rig;
+  rig.file = file;
+  if (root["rig"]) rig.name = r.text(root["rig"], "rig");
+
+  const YAML::Node sensors = r.required(root, "sensors", "the rig file");
+  if (!sensors.IsSequence() || sensors.size() == 0) r.fail(sensors, "'sensors' must be a non-empty list");
+  std::set<std::string> names;
+  for (const auto& n : sensors) {
+    SensorConfig s = readSensor(r, n);
+    if (!names.insert(s.name).second) r.fail(n, "sensor name '" + s.name + "' is used twice");
+    rig.sensors.push_back(std::move(s));
+  }
+  const std::vector<std::string> sensor_names(names.begin(), names.end());
+  const auto requireSensor = [&](const YAML::Node& n, const std::string& name) {
+    if (names.count(name)) return;
+    std::string msg = "no sensor named '" + name + "'";
+    if (const std::string near = closestName(name, sensor_names); !near.empty())
+      msg += " (did you mean '" + near + "'?)";
+    r.fail(n, msg);
+  };
+
+  const YAML::Node roles = r.required(root, "roles", "the rig file");
+  r.requireMap(roles, "roles");
+  r.checkKeys(roles, {"mapping_lidar", "calibration_lidars", "base_frame"}, "roles");
+  const YAML::Node mapping = r.required(roles, "mapping_lidar", "roles");
+  rig.roles.mapping_lidar = r.text(mapping, "mapping_lidar");
+  requireSensor(mapping, rig.roles.mapping_lidar);
+  if (const YAML::Node calib = roles["calibration_lidars"]) {
+    if (!calib.IsSequence()) r.fail(calib, "'calibration_lidars' must be a list of sensor names");
+    for (const auto& c : calib) {
+      const std::string name = r.text(c, "calibration_lidars");
+      requireSensor(c, name);
+      if (name == rig.roles.mapping_lidar) r.fail(c, "'" + name + "' is the mapping lidar; it cannot also be calibrated against itself");
+      rig.roles.calibration_lidars.push_back(name);
+    }
+  }
+  if (roles["base_frame"]) rig.roles.base_frame = r.text(roles["base_frame"], "base_frame");
+
+  for (const auto& s : rig.sensors) rig.initial_T_base_sensor[s.name] = Pose::Identity();
+  if (const YAML::Node ex = root["initial_extrinsics"]) {
+    r.requireMap(ex, "initial_extrinsics");
+    for (const auto& kv : ex) {
+      const std::string name = kv.first.as<std::string>();
+      requireSensor(kv.first, name);
+      rig.initial_T_base_sensor[name] = readExtrinsic(r, kv.second, name);
+    }
+  }
+
+  if (const YAML::Node params = root["parameters"]) readParameters(r, params, rig.parameters, rig.warnings);
+  checkConsistency(r, root, rig);
+  return rig;
+}
+
+}  // namespace rigcal::config
