@@ -37,7 +37,8 @@ TEST(LinkLayer, ParsesEthernetWithStackedVlanTags) {
   const auto d = udpDatagram(10);
   for (int tags : {0, 1, 2}) {
     Ipv4Header ip;
-    ASSERT_EQ(parseFrame(LinkType::kEthernet, frame(d, 0, false, tags), ip), FrameResult::kIpv4);
+    const auto f = frame(d, 0, false, tags);  // ip.payload points into it
+    ASSERT_EQ(parseFrame(LinkType::kEthernet, f, ip), FrameResult::kIpv4);
     EXPECT_EQ(ip.source, 0x0a050501u);
     const auto udp = parseUdp(ip.payload);
     ASSERT_TRUE(udp);
