@@ -1,0 +1,150 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rigcal/pipeline/frame_tracker.hpp"
+
+namespace rigcal::pipeline {
+namespace {
+
+constexpr TimeNs kPeriod = 100 * kNsPerMs;  // 10 Hz
+
+Pose at(double x, double y = 0, double yaw = 0) { return fromXyzRpy({x, y, 0, 0, 0, yaw}); }
+
+struct Drive {
+  FrameTracker tracker{config::Parameters{}};
+  std::uint64_t seq = 0;
+  TimeNs t = 0;
+  std::vector<MappingFrame> out;
+  MappingFrame step(const Pose& pose, bool ok = true, TimeNs dt = kPeriod) {
+    t += dt;
+    out.push_back(tracker.add(seq++, t, pose, ok));
+    return out.back();
+  }
+};
+
+TEST(FrameTracker, StraightDriveStoresFramesAndKeyframesEveryMetre) {
+  Drive d;
+  const double v = 5.0 / 3.6;  // 5 km/h
+  for (int i = 0; i < 100; ++i) d.step(at(v * 0.1 * i));
+  const auto& frames = d.tracker.frames();
+  EXPECT_EQ(frames.size(), 100u);
+  const auto& kfs = d.tracker.keyframes();
+  ASSERT_GE(kfs.size(), 12u);
+  for (std::size_t k = 1; k < kfs.size(); ++k) {
+    const double gap = frames[kfs[k]].path_length - frames[kfs[k - 1]].path_length;
+    EXPECT_GE(gap, 1.0 - 1e-9);
+    EXPECT_LT(gap, 1.0 + v * 0.1 + 1e-9);
+    EXPECT_FALSE(frames[kfs[k]].lost) << frames[kfs[k]].lost_reason;
+  }
+  EXPECT_NEAR(frames.back().speed, v, 1e-9);
+}
+
+TEST(FrameTracker, StopYieldsOneStoppedKeyframeAfterFiveStoppedFrames) {
+  Drive d;
+  for (int i = 0; i < 10; ++i) d.step(at(0.14 * i));
+  const double x = 0.14 * 9;
+  int stopped_keyframes = 0, stopped = 0;
+  for (int i = 0; i < 30; ++i) {
+    const MappingFrame f = d.step(at(x + 0.001 * (i % 2)));  // standing still, a millimetre of noise
+    stopped += f.kind == FrameKind::kStopped;
+    if (f.kind == FrameKind::kStoppedKeyframe) {
+      ++stopped_keyframes;
+      EXPECT_EQ(stopped, 4) << "the fifth stopped frame in a row is the stopped keyframe";
+    }
+  }
+  EXPECT_EQ(stopped_keyframes, 1);
+  // The first standstill frame is dropped: its delta (0) differs from the last motion (0.14 m).
+  EXPECT_EQ(stopped, 28);
+  // Driving off again resumes ordinary frames.
+  EXPECT_EQ(d.step(at(x + 0.14)).kind, FrameKind::kFrame);
+}
+
+TEST(FrameTracker, CreepingBelowTheFrameDistanceAlternatesDroppedAndStored) {
+  Drive d;
+  d.step(at(0.0));
+  // 0.3 m/s: 3 cm per frame. A frame 3 cm on is dropped (|0.03 − 0.06| ≥ frame_stopped_distance, so
+  // not stopped); the next, 6 cm on, is stored.
+  for (int i = 1; i <= 10; ++i) {
+    const MappingFrame f = d.step(at(0.03 * i));
+    EXPECT_EQ(f.kind, i % 2 ? FrameKind::kDropped : FrameKind::kFrame) << i;
+    EXPECT_FALSE(f.lost) << f.lost_reason;
+  }
+}
+
+TEST(FrameTracker, RegistrationFailureTimeoutAndJerkAreLost) {
+  {
+    Drive d;
+    for (int i = 0; i < 5; ++i) d.step(at(0.14 * i));
+    const MappingFrame f = d.step(at(0.14 * 5), false);
+    EXPECT_TRUE(f.lost);
+    EXPECT_TRUE(f.isKeyframe()) << "lost frames are kept as keyframes";
+    EXPECT_EQ(f.lost_reason, "registration failed");
+  }
+  {
+    Drive d;
+    for (int i = 0; i < 5; ++i) d.step(at(0.14 * i));
+    const MappingFrame f = d.step(at(0.14 * 5), true, 1200 * kNsPerMs);
+    EXPECT_TRUE(f.lost);
+    EXPECT_NE(f.lost_reason.find("no frame for"), std::string::npos);
+  }
+  {
+    Drive d;
+    for (int i = 0; i < 5; ++i) d.step(at(0.14 * i));
+    const MappingFrame f = d.step(at(0.14 * 4 + 0.35));  // 1.4 → 3.5 m/s in 0.1 s: 21 m/s²
+    EXPECT_TRUE(f.lost);
+    EXPECT_NE(f.lost_reason.find("acceleration"), std::string::npos);
+  }
+}
+
+TEST(FrameTracker, KeyframeLostCheckFiresOnASharpCorner) {
+  Drive d;
+  for (int i = 0; i <= 30; ++i) d.step(at(0.1 * i));  // 3 m east
+  bool lost = false;
+  for (int i = 1; i <= 15 && !lost; ++i) lost = d.step(at(3.0, 0.1 * i, M_PI / 2)).lost;  // then north
+  EXPECT_TRUE(lost);
+}
+
+TEST(FrameTracker, KeyframeLostCheckFiresOnAFrameOffTheInterpolation) {
+  Drive d;
+  for (int i = 0; i <= 12; ++i) d.step(at(0.1 * i));
+  d.step(at(1.3, 0.12));  // one frame jumps 12 cm sideways and back
+  bool lost = false;
+  for (int i = 14; i <= 30 && !lost; ++i) {
+    const MappingFrame f = d.step(at(0.1 * i));
+    if (f.isKeyframe()) {
+      lost = f.lost;
+      EXPECT_NE(f.lost_reason.find("off the keyframe interpolation"), std::string::npos) << f.lost_reason;
+    }
+  }
+  EXPECT_TRUE(lost);
+}
+
+TEST(FrameTracker, SmoothTurnIsNotLost) {
+  Drive d;
+  const double radius = 8.0, v = 5.0 / 3.6;
+  for (int i = 0; i < 200; ++i) {
+    const double a = v * 0.1 * i / radius;
+    const MappingFrame f = d.step(at(radius * std::sin(a), radius * (1 - std::cos(a)), a));
+    EXPECT_FALSE(f.lost) << "frame " << i << ": " << f.lost_reason;
+  }
+}
+
+TEST(FrameTracker, PredictExtrapolatesConstantVelocity) {
+  Drive d;
+  for (int i = 0; i < 5; ++i) d.step(at(0.14 * i, 0, 0.01 * i));
+  const Pose p = d.tracker.predict(d.t + kPeriod);
+  EXPECT_NEAR(toXyzRpy(p).yaw, 0.05, 1e-9);
+  EXPECT_NEAR(p.translation().norm(), 0.7, 2e-3);
+}
+
+TEST(FrameTracker, StopsByItselfAtMappingMaxFrames) {
+  config::Parameters p;
+  p.mapping_max_frames = 20;
+  FrameTracker tracker(p);
+  for (int i = 0; i < 20; ++i) tracker.add(i, i * kPeriod, at(0.14 * i), true);
+  EXPECT_TRUE(tracker.full());
+}
+
+}  // namespace
+}  // namespace rigcal::pipeline
