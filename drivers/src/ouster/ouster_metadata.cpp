@@ -166,7 +166,7 @@ DataFormatSeen readDataFormat(const Reader& r, const Json& df, const std::string
   DataFormatSeen seen;
   seen.present = true;
   const std::string p = name + ".";
-  m.pixels_per_column = r.requiredInt(df, "pixels_per_column", p, 1, 1024);
+  m.pixels_per_column = r.requiredInt(df, "pixels_per_column", p, 1, 256);
   m.columns_per_packet = r.requiredInt(df, "columns_per_packet", p, 1, 4096);
   m.columns_per_frame = r.requiredInt(df, "columns_per_frame", p, 1, 65536);
   if (!validColumns(m.columns_per_frame))
@@ -232,7 +232,7 @@ void finish(const Reader& r, Metadata& m, const DataFormatSeen& df, const std::s
   if (m.beam_azimuth_deg.size() != n)
     r.fail(angles_prefix + "beam_azimuth_angles", std::to_string(m.beam_azimuth_deg.size()) +
                                                       " angles but beam_altitude_angles has " + std::to_string(n));
-  if (m.pixels_per_column < 1 || m.pixels_per_column > 1024)
+  if (m.pixels_per_column < 1 || m.pixels_per_column > 256)
     r.fail(angles_prefix + "beam_altitude_angles", "unsupported beam count " + std::to_string(n));
   if (std::size_t(m.pixels_per_column) != n)
     r.fail(angles_prefix + "beam_altitude_angles", std::to_string(n) + " angles but " + format_name +

@@ -45,17 +45,22 @@ PixelFields readPixel(const std::uint8_t* px) {
   return f;
 }
 
-constexpr std::array<std::uint64_t, 256> makeCrcTable() {
+// Slicing-by-8 tables for the reflected CRC-64/XZ: table[0] is the byte-wise table, table[k][i] the
+// CRC of byte i followed by k zero bytes.
+using CrcTables = std::array<std::array<std::uint64_t, 256>, 8>;
+constexpr CrcTables makeCrcTables() {
   constexpr std::uint64_t kPoly = 0xC96C5795D7870F42ull;  // ECMA-182, reflected
-  std::array<std::uint64_t, 256> t{};
+  CrcTables t{};
   for (std::uint64_t i = 0; i < 256; ++i) {
     std::uint64_t r = i;
     for (int j = 0; j < 8; ++j) r = (r & 1) ? (r >> 1) ^ kPoly : r >> 1;
-    t[i] = r;
+    t[0][i] = r;
   }
+  for (std::size_t k = 1; k < 8; ++k)
+    for (std::size_t i = 0; i < 256; ++i) t[k][i] = (t[k - 1][i] >> 8) ^ t[0][t[k - 1][i] & 0xff];
   return t;
 }
-constexpr std::array<std::uint64_t, 256> kCrcTable = makeCrcTable();
+constexpr CrcTables kCrc = makeCrcTables();
 
 }  // namespace
 
@@ -103,7 +108,14 @@ PixelFields PacketFormat::pixelFields(const std::uint8_t* px) const {
 
 std::uint64_t crc64(const std::uint8_t* data, std::size_t size) {
   std::uint64_t crc = ~0ull;
-  for (std::size_t i = 0; i < size; ++i) crc = kCrcTable[(crc ^ data[i]) & 0xff] ^ (crc >> 8);
+  std::size_t i = 0;
+  for (; i + 8 <= size; i += 8) {
+    crc ^= loadLe<std::uint64_t>(data + i);
+    crc = kCrc[7][crc & 0xff] ^ kCrc[6][(crc >> 8) & 0xff] ^ kCrc[5][(crc >> 16) & 0xff] ^
+          kCrc[4][(crc >> 24) & 0xff] ^ kCrc[3][(crc >> 32) & 0xff] ^ kCrc[2][(crc >> 40) & 0xff] ^
+          kCrc[1][(crc >> 48) & 0xff] ^ kCrc[0][crc >> 56];
+  }
+  for (; i < size; ++i) crc = kCrc[0][(crc ^ data[i]) & 0xff] ^ (crc >> 8);
   return ~crc;
 }
 

@@ -312,3 +312,24 @@ TEST(OusterRawScan, DestaggerShiftsEachRow) {
 
 }  // namespace
 }  // namespace rigcal::drivers::ouster
+
+namespace rigcal::drivers::ouster {
+namespace {
+
+TEST(OusterPacketFormat, Crc64IsTheXzVariant) {
+  const std::string check = "123456789";
+  EXPECT_EQ(crc64(reinterpret_cast<const std::uint8_t*>(check.data()), check.size()), 0x995DC9BBDF1939FAull);
+  std::vector<std::uint8_t> long_input(1000);
+  for (std::size_t i = 0; i < long_input.size(); ++i) long_input[i] = std::uint8_t(i * 7 + 3);
+  // Slicing-by-8 and the byte-wise tail agree with each other on every split.
+  const std::uint64_t whole = crc64(long_input.data(), long_input.size());
+  EXPECT_NE(whole, crc64(long_input.data(), long_input.size() - 1));
+  EXPECT_EQ(PacketFormat(UdpProfile::kRng15Rfl8Nir8, 128, 16).packet_size, 8448u);
+  EXPECT_EQ(PacketFormat(UdpProfile::kLegacy, 64, 16).packet_size, 12608u);
+  EXPECT_EQ(PacketFormat(UdpProfile::kFusaRng15Rfl8Nir8Dual, 128, 16).packet_size, 16640u);
+  EXPECT_EQ(PacketFormat(UdpProfile::kRng19Rfl8Sig16Nir16Dual, 32, 16).packet_size, 8448u);
+  EXPECT_THROW(PacketFormat(UdpProfile::kFiveWordPixel, 256, 64), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rigcal::drivers::ouster
