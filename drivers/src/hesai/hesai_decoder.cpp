@@ -80,12 +80,18 @@ HesaiDecoder::HesaiDecoder(const hesai::ModelSpec& spec, const hesai::Calibratio
     const std::uint8_t flag = v == 2 ? 1 : 0;
     auto& t = times_[v];
     t.resize(std::size_t(spec.blocks) * channels_);
+    bool any = false;
     for (int b = 0; b < spec.blocks; ++b)
-      for (int c = 0; c < channels_; ++c)
-        t[std::size_t(b) * channels_ + c] =
-            static_cast<std::int32_t>(hesai::firingOffsetNs(spec.model, returns, b, c, flag));
-    first_firing_ns_[v] = *std::min_element(t.begin(), t.end());
-    last_firing_ns_[v] = *std::max_element(t.begin(), t.end());
+      for (int c = 0; c < channels_; ++c) {
+        const auto ns = static_cast<std::int32_t>(hesai::firingOffsetNs(spec.model, returns, b, c, flag));
+        t[std::size_t(b) * channels_ + c] = ns;
+        // QT128 channels outside the block's firing sequence carry no data: not a firing.
+        const int loop = returns == 1 ? b + 1 : (flag ? 1 : 2);
+        if (spec.model == hesai::Model::kQT128 && hesai::qt128LoopOffsetNs(loop, c) == 0) continue;
+        first_firing_ns_[v] = any ? std::min(first_firing_ns_[v], ns) : ns;
+        last_firing_ns_[v] = any ? std::max(last_firing_ns_[v], ns) : ns;
+        any = true;
+      }
   }
 }
 
