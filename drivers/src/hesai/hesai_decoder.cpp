@@ -22,6 +22,22 @@ std::int64_t floorDiv(std::int64_t a, std::int64_t b) {
   return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
 }
 
+// cos/sin of every block azimuth (0.01° steps), shared by all decoders.
+struct AzimuthTable {
+  std::vector<float> cos, sin;
+  AzimuthTable() : cos(kUnitsPerTurn), sin(kUnitsPerTurn) {
+    for (std::int64_t a = 0; a < kUnitsPerTurn; ++a) {
+      const double rad = static_cast<double>(a) * 0.01 * kPi / 180.0;
+      cos[a] = static_cast<float>(std::cos(rad));
+      sin[a] = static_cast<float>(std::sin(rad));
+    }
+  }
+};
+const AzimuthTable& azimuthTable() {
+  static const AzimuthTable table;
+  return table;
+}
+
 const hesai::ModelSpec& requireModel(const std::string& name) {
   if (const hesai::ModelSpec* spec = hesai::findModel(name)) return *spec;
   std::string known;
@@ -67,13 +83,8 @@ HesaiDecoder::HesaiDecoder(const hesai::ModelSpec& spec, const hesai::Calibratio
   }
   min_shift_ = shift_.front();
 
-  cos_az_.resize(kUnitsPerTurn);
-  sin_az_.resize(kUnitsPerTurn);
-  for (std::int64_t a = 0; a < kUnitsPerTurn; ++a) {
-    const double rad = static_cast<double>(a) * 0.01 * kPi / 180.0;
-    cos_az_[a] = static_cast<float>(std::cos(rad));
-    sin_az_[a] = static_cast<float>(std::sin(rad));
-  }
+  cos_az_ = azimuthTable().cos.data();
+  sin_az_ = azimuthTable().sin.data();
 
   for (int v = 0; v < kVariants; ++v) {
     const int returns = v == 0 ? 1 : 2;

@@ -315,6 +315,34 @@ TEST(HesaiDecoder, RangeLimitsCombineConfigAndSensor) {
   }
 }
 
+TEST(HesaiDecoder, AzimuthJumpsRestartTheOrderingWithoutLosingPoints) {
+  RIGCAL_REQUIRE_DATA(path, "hesai/qt128_laststrongest.pcap");
+  const Capture capture = loadCapture(path);
+  const DecoderConfig config = configFor("PandarQT128", path.parent_path() / "PandarQT128.csv");
+  auto count = [&](const std::vector<std::size_t>& order, HesaiDecoder& decoder) {
+    DecodedPacket out;
+    std::size_t n = 0;
+    for (std::size_t i : order) {
+      decoder.decode(capture.packet(i), out);
+      EXPECT_EQ(out.points.size(), out.azimuth_deg.size());
+      n += out.points.size();
+    }
+    decoder.flush(out);
+    return n + out.points.size();
+  };
+  std::vector<std::size_t> forward(capture.size());
+  std::iota(forward.begin(), forward.end(), 0);
+  // Packets 600-1199 first: the rotor appears to jump back by 120°, then forward by 240°.
+  std::vector<std::size_t> jumbled(forward.begin() + 600, forward.begin() + 1200);
+  jumbled.insert(jumbled.end(), forward.begin(), forward.begin() + 600);
+  jumbled.insert(jumbled.end(), forward.begin() + 1200, forward.end());
+  HesaiDecoder a(config), b(config);
+  const std::size_t in_order = count(forward, a);
+  EXPECT_EQ(count(jumbled, b), in_order);
+  EXPECT_EQ(a.stats().discontinuities, 0u);
+  EXPECT_GE(b.stats().discontinuities, 1u);
+}
+
 // With the cut at 180°, every full sweep starts with the points whose own azimuth is just past 180°
 // and ends with those just short of it, although QT128 channel offsets reach ±10°.
 TEST(HesaiDecoder, SweepsAreCutByEachPointsOwnAzimuth) {

@@ -68,7 +68,8 @@ class HesaiDecoder final : public PacketDecoder {
   std::vector<std::int64_t> shift_;       // bucket of (block azimuth 0 + offset)
   std::vector<float> xy_cos_, xy_sin_, z_sin_;  // cosω·cos(o), cosω·sin(o), sinω
   std::int64_t min_shift_ = 0;
-  std::vector<float> cos_az_, sin_az_;    // per 0.01° of block azimuth
+  const float* cos_az_ = nullptr;         // per 0.01° of block azimuth (a shared table)
+  const float* sin_az_ = nullptr;
   // times_[variant][block * channels + channel]: firing time relative to t0 (ns).
   std::vector<std::int32_t> times_[kVariants];
   std::int32_t first_firing_ns_[kVariants] = {};
