@@ -173,6 +173,7 @@ void HesaiDecoder::decode(const UdpPacket& packet, DecodedPacket& out) {
   out.packet_time_ns = t0 + first_firing_ns_[v];
   out.order_key = orderKey(view, t0, out.lost_before);
 
+  const RawLimits& limits = rawLimits(view.dis_unit_mm);
   std::optional<std::int64_t> release_up_to;
   for (int b = 0; b < view.blocks; b += view.returns) {
     const std::int64_t az = view.azimuth(b);
@@ -194,7 +195,12 @@ void HesaiDecoder::decode(const UdpPacket& packet, DecodedPacket& out) {
         unwrapped = last + ahead;
       }
     }
-    decodeGroup(view, b, unwrapped, t0, times_[v].data() + std::size_t(b) * channels_);
+    const std::int32_t* times = times_[v].data() + std::size_t(b) * channels_;
+    if (view.returns == 2) {
+      decodeGroup<2>(view, b, unwrapped, t0, times, limits);
+    } else {
+      decodeGroup<1>(view, b, unwrapped, t0, times, limits);
+    }
     if (in_order) {
       last_azimuth_ = unwrapped;
       release_up_to = unwrapped + min_shift_;
@@ -207,30 +213,58 @@ void HesaiDecoder::decode(const UdpPacket& packet, DecodedPacket& out) {
   }
 }
 
+const HesaiDecoder::RawLimits& HesaiDecoder::rawLimits(std::uint8_t dis_unit_mm) {
+  RawLimits& l = raw_limits_[dis_unit_mm];
+  if (l.unit_mm == dis_unit_mm) return l;
+  // The float distance is monotonic in the raw value: find the raw interval whose distance passes
+  // the range filter, and the raw differences that certainly are (not) within the dual threshold.
+  const double scale = dis_unit_mm / 1000.0;
+  auto distance = [&](std::uint32_t raw) { return static_cast<float>(raw * scale); };
+  l.min_raw = 1;
+  while (l.min_raw <= 0xFFFF && distance(l.min_raw) < min_range_m_) ++l.min_raw;
+  l.max_raw = 0xFFFF;
+  while (l.max_raw >= l.min_raw && distance(l.max_raw) > max_range_m_) --l.max_raw;
+  // Raw differences up to `near_raw` are within 0.1 m whatever the float rounding (its error stays
+  // below 0.1 mm up to 262 m); from `far_raw` on they never are; in between float decides.
+  l.near_raw = static_cast<std::uint32_t>(std::floor((kDualReturnThresholdM - 1e-4) / scale));
+  l.far_raw = static_cast<std::uint32_t>(std::ceil((kDualReturnThresholdM + 1e-4) / scale));
+  l.scale = scale;
+  l.unit_mm = dis_unit_mm;
+  return l;
+}
+
+template <int kReturns>
 void HesaiDecoder::decodeGroup(const hesai::PacketView& view, int first_block, std::int64_t unwrapped, TimeNs t0,
-                               const std::int32_t* times) {
-  const int returns = view.returns;
+                               const std::int32_t* times, const RawLimits& limits) {
   const std::size_t az_index = static_cast<std::size_t>(unwrapped % kUnitsPerTurn);
   const float ca = cos_az_[az_index], sa = sin_az_[az_index];
-  const double scale = view.dis_unit_mm / 1000.0;
-  const std::uint8_t* blocks[2] = {view.block(first_block) + 2, view.block(first_block + returns - 1) + 2};
+  const float scale = static_cast<float>(limits.scale);
+  const std::uint8_t* blocks[2] = {view.block(first_block) + 2, view.block(first_block + kReturns - 1) + 2};
   for (int j = 0; j < channels_; ++j) {
     const int c = order_[j];
-    float distance[2];
-    std::uint16_t raw[2];
-    for (int k = 0; k < returns; ++k) {
+    std::uint32_t raw[kReturns];
+    std::uint32_t any = 0;
+    for (int k = 0; k < kReturns; ++k) {
       const std::uint8_t* u = blocks[k] + 4 * c;
-      raw[k] = static_cast<std::uint16_t>(u[0] | (u[1] << 8));
-      distance[k] = static_cast<float>(raw[k] * scale);
+      raw[k] = static_cast<std::uint32_t>(u[0] | (u[1] << 8));
+      any |= raw[k];
     }
-    for (int k = 0; k < returns; ++k) {
-      if (raw[k] == 0) continue;
-      const float d = distance[k];
-      if (d < min_range_m_ || d > max_range_m_) continue;
-      // Dual return: keep the last; drop the other when it is within 0.1 m of it.
-      if (k + 1 < returns && std::fabs(distance[1] - d) < kDualReturnThresholdM) continue;
+    if (any == 0) continue;  // no return, or a channel outside this firing sequence
+    for (int k = 0; k < kReturns; ++k) {
+      if (raw[k] < limits.min_raw || raw[k] > limits.max_raw) continue;  // also drops raw 0
+      if (k + 1 < kReturns) {
+        // Dual return: keep the last; drop the other when it is within 0.1 m of it (computed in
+        // float, as nebula does, when the difference sits right on the threshold).
+        const std::uint32_t diff = raw[k] > raw[k + 1] ? raw[k] - raw[k + 1] : raw[k + 1] - raw[k];
+        if (diff <= limits.near_raw) continue;
+        if (diff < limits.far_raw &&
+            std::fabs(static_cast<float>(raw[k + 1] * limits.scale) - static_cast<float>(raw[k] * limits.scale)) <
+                kDualReturnThresholdM)
+          continue;
+      }
+      const float d = static_cast<float>(raw[k]) * scale;
       const float cx = xy_cos_[j], sx = xy_sin_[j];
-      Point p;
+      Point& p = order_buffer_.emplace(unwrapped + shift_[j]);
       p.x = d * (cx * ca - sx * sa);
       p.y = -d * (cx * sa + sx * ca);
       p.z = d * z_sin_[j];
@@ -238,7 +272,6 @@ void HesaiDecoder::decodeGroup(const hesai::PacketView& view, int first_block, s
       p.ring = static_cast<std::uint16_t>(c);
       p.time_ns = t0 + times[c];
       p.return_index = static_cast<std::uint8_t>(k);
-      order_buffer_.push(p, unwrapped + shift_[j]);
     }
   }
   order_buffer_.endRun();

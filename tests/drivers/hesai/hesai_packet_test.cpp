@@ -88,15 +88,19 @@ TEST(HesaiPacket, Crc32Mpeg2CheckValue) {
   const std::string check = "123456789";
   EXPECT_EQ(crc32Mpeg2({reinterpret_cast<const std::uint8_t*>(check.data()), check.size()}), 0x0376E6E7u);
   EXPECT_EQ(crc32Mpeg2({}), 0xFFFFFFFFu);
-  std::vector<std::uint8_t> long_input(1027);
-  for (std::size_t i = 0; i < long_input.size(); ++i) long_input[i] = static_cast<std::uint8_t>(i * 7 + 3);
-  // Slicing-by-8 against the bitwise definition.
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::uint8_t b : long_input) {
-    c ^= std::uint32_t(b) << 24;
-    for (int k = 0; k < 8; ++k) c = (c & 0x80000000u) ? (c << 1) ^ 0x04C11DB7u : (c << 1);
+  // The fast paths (slicing-by-16, carry-less multiplication folding) against the bitwise
+  // definition, for every length up to 300 bytes and the QT128 body length.
+  std::vector<std::uint8_t> input(1028);
+  std::uint32_t seed = 12345;
+  for (auto& b : input) b = static_cast<std::uint8_t>((seed = seed * 1103515245u + 12345u) >> 24);
+  for (std::size_t n = 0; n <= input.size(); n = n < 300 ? n + 1 : input.size() + (n == input.size())) {
+    std::uint32_t c = 0xFFFFFFFFu;
+    for (std::size_t i = 0; i < n; ++i) {
+      c ^= std::uint32_t(input[i]) << 24;
+      for (int k = 0; k < 8; ++k) c = (c & 0x80000000u) ? (c << 1) ^ 0x04C11DB7u : (c << 1);
+    }
+    ASSERT_EQ(crc32Mpeg2({input.data(), n}), c) << "length " << n;
   }
-  EXPECT_EQ(crc32Mpeg2(long_input), c);
 }
 
 TEST(HesaiPacket, UtcSecondsIgnoresTheTimeZone) {

@@ -21,7 +21,12 @@ namespace rigcal::drivers::hesai {
 class AzimuthOrder {
  public:
   /// Adds one point of the current run; within a run buckets must not decrease.
-  void push(const Point& point, std::int64_t bucket) { items_.push_back(Entry{point, bucket}); }
+  void push(const Point& point, std::int64_t bucket) { emplace(bucket) = point; }
+  /// Adds a point in `bucket` and returns it for the caller to fill in.
+  Point& emplace(std::int64_t bucket) {
+    buckets_.push_back(bucket);
+    return points_.emplace_back();
+  }
   /// Closes the run of points pushed since the last endRun().
   void endRun();
   /// Appends to `out` (points and azimuth_deg) every held point whose bucket is ≤ up_to, sorted by
@@ -36,17 +41,15 @@ class AzimuthOrder {
   static float bucketAzimuthDeg(std::int64_t bucket);
 
  private:
-  struct Entry {
-    Point point;
-    std::int64_t bucket;
-  };
   struct Run {
-    std::size_t begin, end, cursor, scan_end;
+    std::size_t end, cursor, scan_end;
   };
   void emit(std::int64_t up_to, DecodedPacket& out);
+  void emitBySort(std::int64_t up_to, std::int64_t lo, std::size_t base, DecodedPacket& out);
   void compact();
 
-  std::vector<Entry> items_;
+  std::vector<Point> points_;            // held points, runs one after another
+  std::vector<std::int64_t> buckets_;    // their buckets
   std::vector<Run> runs_;
   std::size_t run_head_ = 0;
   std::size_t run_start_ = 0;             // first item of the run being pushed
@@ -54,6 +57,7 @@ class AzimuthOrder {
   std::vector<std::uint32_t> counts_;     // reused counting-sort histogram
   std::vector<float> bucket_az_;
   std::vector<std::pair<std::int64_t, std::size_t>> spill_;  // fallback sort for wide ranges
+  std::vector<std::uint32_t> slots_;     // counting sort: item (relative to its batch) per output slot
 };
 
 }  // namespace rigcal::drivers::hesai

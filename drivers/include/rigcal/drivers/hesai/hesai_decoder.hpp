@@ -17,6 +17,7 @@
 // kHostReceive takes UdpPacket::receive_ns as the time of the packet's last firing. Point times add
 // the manual's per-block and per-channel firing offsets (hesai_packet.hpp).
 // Loss: gaps in the tail's udp_sequence give lost_before; order_key is the udp_sequence (unwrapped).
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -54,8 +55,17 @@ class HesaiDecoder final : public PacketDecoder {
   static constexpr int kVariants = 3;
   static int variant(int returns, std::uint8_t mode_flag) { return returns == 1 ? 0 : (mode_flag & 1) ? 2 : 1; }
 
+  // Range and dual-return thresholds in raw distance units, per distance unit (header dis_unit).
+  struct RawLimits {
+    std::uint8_t unit_mm = 0;  // 0: not computed yet
+    double scale = 0;          // metres per raw unit
+    std::uint32_t min_raw = 0, max_raw = 0;
+    std::uint32_t near_raw = 0, far_raw = 0;
+  };
+  const RawLimits& rawLimits(std::uint8_t dis_unit_mm);
+  template <int kReturns>
   void decodeGroup(const hesai::PacketView& view, int first_block, std::int64_t unwrapped_azimuth, TimeNs t0,
-                   const std::int32_t* times);
+                   const std::int32_t* times, const RawLimits& limits);
   [[nodiscard]] std::uint64_t orderKey(const hesai::PacketView& view, TimeNs t0, std::uint32_t& lost);
 
   const hesai::ModelSpec& spec_;
@@ -75,6 +85,7 @@ class HesaiDecoder final : public PacketDecoder {
   std::int32_t first_firing_ns_[kVariants] = {};
   std::int32_t last_firing_ns_[kVariants] = {};
 
+  std::array<RawLimits, 256> raw_limits_{};
   hesai::AzimuthOrder order_buffer_;
   std::optional<std::int64_t> last_azimuth_;  // unwrapped, 0.01° units
   std::optional<std::uint32_t> last_sequence_;
