@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "rigcal/drivers/hesai/hesai_decoder.hpp"
 #include "rigcal/drivers/ouster/ouster_decoder.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
 
@@ -16,6 +17,7 @@ struct Vendor {
 const std::vector<Vendor>& vendors() {
   static const std::vector<Vendor> table = {
       {ousterModels, makeOusterDecoder},
+      {hesaiModels, makeHesaiDecoder},
   };
   return table;
 }

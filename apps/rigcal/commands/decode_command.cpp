@@ -76,6 +76,8 @@ void run(const DecodeOptions& o) {
     decoder->decode(*packet, decoded);
     assembler.add(decoded);
   }
+  decoder->flush(decoded);
+  if (!decoded.points.empty()) assembler.add(decoded);
   assembler.flush();
 
   const auto& a = assembler.stats();

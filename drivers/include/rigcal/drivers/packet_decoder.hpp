@@ -56,6 +56,9 @@ class PacketDecoder {
   virtual ~PacketDecoder() = default;
   /// Decodes `packet` into `out` (reset first). Never throws on packet content.
   virtual void decode(const UdpPacket& packet, DecodedPacket& out) = 0;
+  /// End of input: hands over points the decoder still holds back (Hesai orders points by azimuth
+  /// across packets). `out` is reset first; feed it to the assembler when it has points.
+  virtual void flush(DecodedPacket& out) { out.reset(); }
   [[nodiscard]] virtual std::string model() const = 0;
   /// Nominal sweep rate (Hz), from metadata or the packet stream once known; 10 until then.
   [[nodiscard]] virtual double scanRateHz() const { return 10.0; }

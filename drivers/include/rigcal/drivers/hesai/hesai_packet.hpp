@@ -1,0 +1,108 @@
+#pragma once
+// Hesai point-cloud packet formats: PandarXT16 / PandarXT32 (UDP protocol 6.1) and PandarQT128
+// (QT128C2X, protocol 3.2). Layouts, validation and the per-model laser firing times; no decoding
+// into points (hesai_decoder.cpp does that). All multi-byte fields are little endian.
+//
+// Protocol 6.1 (XT16: 568 bytes, XT32: 1080 bytes):
+//   header 12 | 8 blocks × (azimuth u16 + channels × (distance u16, reflectivity u8, reserved u8)) |
+//   tail 24 (reserved 9, high-temperature flag, return mode, motor rpm u16, date 6, µs timestamp u32,
+//   factory byte) | udp_sequence u32.  No CRC.
+// Protocol 3.2 (QT128C2X, 1127 bytes with every option on):
+//   header 12 | 2 blocks × (azimuth u16 + 128 × 4 bytes) | CRC1 u32 (body) |
+//   functional safety 17 (if flags bit 2; ends with its own CRC2) |
+//   tail 26 (reserved 5, mode flag, reserved 6, return mode, motor rpm u16, date 6, µs timestamp u32,
+//   factory byte) | udp_sequence u32 (if flags bit 0) | CRC3 u32 (tail + udp_sequence) |
+//   digital signature 32 (if flags bit 3).
+// The three CRCs are CRC-32/MPEG-2. They are checked and counted, never a reason to drop a packet:
+// the manual does not make them mandatory for decoding.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace rigcal::drivers::hesai {
+
+enum class Model : std::uint8_t { kXT16, kXT32, kQT128 };
+
+struct ModelSpec {
+  Model model;
+  std::string_view name;             // "PandarXT32", ...
+  std::uint8_t protocol_major;
+  std::uint8_t protocol_minor;
+  std::uint16_t channels;
+  std::uint16_t blocks;
+  float min_range_m;                 // the sensor's own range limits
+  float max_range_m;
+  std::size_t max_points_per_scan;   // slowest rotation, dual return, every channel
+};
+
+/// The models this decoder reads, and lookup by exact name (nullptr when unknown).
+std::span<const ModelSpec> allModels();
+const ModelSpec* findModel(std::string_view name);
+
+/// Return-mode byte of the tail.
+namespace return_mode {
+inline constexpr std::uint8_t kFirst = 0x33, kSecond = 0x34, kStrongest = 0x37, kLast = 0x38;
+inline constexpr std::uint8_t kLastStrongest = 0x39, kFirstSecond = 0x3A, kFirstLast = 0x3B,
+                              kFirstStrongest = 0x3C, kStrongestSecondStrongest = 0x3E;
+}  // namespace return_mode
+
+/// Returns stored per firing for a return-mode byte: 1, 2, or 0 when the byte is unknown.
+int returnsPerFiring(std::uint8_t mode);
+
+/// A validated packet: pointers into the payload (valid while it is).
+struct PacketView {
+  const std::uint8_t* body = nullptr;   // first block
+  std::uint16_t channels = 0;
+  std::uint16_t blocks = 0;
+  std::uint8_t returns = 1;             // blocks per firing (1 single, 2 dual)
+  std::uint8_t dis_unit_mm = 4;
+  std::uint8_t return_mode = 0;
+  std::uint8_t mode_flag = 0;           // QT128: bit 0 set = firing sequence (loop) 1 in dual mode
+  std::uint16_t motor_rpm = 0;
+  std::array<std::uint8_t, 6> date{};   // year − 1900, month, day, hour, minute, second (UTC)
+  std::uint32_t timestamp_us = 0;       // µs within that second
+  std::optional<std::uint32_t> udp_sequence;
+  bool has_crc = false;                 // protocol 3.2: CRC fields present
+  bool crc_ok = true;                   // all present CRCs match
+
+  [[nodiscard]] std::size_t blockBytes() const { return 2u + 4u * channels; }
+  [[nodiscard]] const std::uint8_t* block(int b) const { return body + b * blockBytes(); }
+  [[nodiscard]] std::uint16_t azimuth(int b) const {
+    const std::uint8_t* p = block(b);
+    return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
+  }
+};
+
+/// Validates `payload` as a packet of `spec` and fills `view`. Returns "" on success, otherwise a
+/// one-line reason naming the field, e.g. "PandarXT32 packet: size 1000, expected 1080".
+/// CRCs are verified (view.crc_ok) but a mismatch is not an error.
+std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> payload, PacketView& view);
+
+/// True for Hesai GPS/PPS packets (512 bytes starting 0xFF 0xEE) that may share the data port.
+bool isGpsPacket(std::span<const std::uint8_t> payload);
+
+/// Firing time (ns) of `channel` (0-based) in `block` (0-based) relative to the packet's absolute
+/// time t0 (tail date + µs timestamp), from the Hesai user manuals (Appendix "Absolute Time and
+/// Laser Firing Time"):
+///  XT16/XT32: block start = t0 + 5.632 µs − 50 µs × (firings after this block's firing);
+///             channel offset = 0.368 µs + 1.512 µs × channel (XT32), 3.024 µs × channel (XT16).
+///  QT128:     block start = t0 + 9 µs (dual: both blocks; single: block 2, block 1 is one firing
+///             round, 111.11 µs, earlier); channel offset from the firing sequence table (loop 1 or
+///             2: single → block 1 uses loop 1, block 2 loop 2; dual → loop 1 when mode_flag bit 0).
+/// Channels that do not fire in the chosen loop get the block start (their distance is 0 anyway).
+std::int64_t firingOffsetNs(Model model, int returns, int block, int channel, std::uint8_t mode_flag);
+
+/// The QT128 firing-sequence offset (ns) of `channel` in loop 1 or 2; 0 = does not fire there.
+std::int32_t qt128LoopOffsetNs(int loop, int channel);
+
+/// Seconds since the UNIX epoch of the tail date (year − 1900, month, day, hour, minute, second),
+/// independent of the local time zone; nullopt when a field is out of range.
+std::optional<std::int64_t> utcSeconds(const std::array<std::uint8_t, 6>& date);
+
+/// CRC-32/MPEG-2 (poly 0x04C11DB7, init 0xFFFFFFFF, no reflection, no final xor).
+std::uint32_t crc32Mpeg2(std::span<const std::uint8_t> bytes);
+
+}  // namespace rigcal::drivers::hesai

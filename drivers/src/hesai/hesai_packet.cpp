@@ -1,0 +1,321 @@
+#include "rigcal/drivers/hesai/hesai_packet.hpp"
+
+#include <algorithm>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
+namespace rigcal::drivers::hesai {
+namespace {
+
+constexpr std::array<ModelSpec, 3> kModels{{
+    {Model::kXT16, "PandarXT16", 6, 1, 16, 8, 0.05f, 120.0f, 128'000},
+    {Model::kXT32, "PandarXT32", 6, 1, 32, 8, 0.05f, 120.0f, 256'000},
+    {Model::kQT128, "PandarQT128", 3, 2, 128, 2, 0.05f, 50.0f, 172'800},
+}};
+
+constexpr std::size_t kHeaderBytes = 12;
+constexpr std::size_t kXtTailBytes = 24;
+constexpr std::size_t kQtTailBytes = 26;
+constexpr std::size_t kQtSafetyBytes = 17;
+constexpr std::size_t kQtSignatureBytes = 32;
+
+// QT128C2X firing sequences (Hesai QT128C2X user manual, Appendix "Absolute Time of Point Cloud
+// Data", firetime table): offset of each channel (index = channel − 1) in ns from the start of its
+// block; 0 = the channel does not fire in that sequence. 96 channels fire per sequence, in 32
+// groups of three 3.168 µs apart (0.600, 1.456, 2.312 µs into the group).
+constexpr std::array<std::int32_t, 128> kQtLoop1{
+    0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,
+    0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,
+    0,     0,     0,     0,     0,     0,     27656, 53000, 2312,  78344, 81512, 5480,  56168,
+    30824, 33992, 59336, 8648,  84680, 87848, 11816, 62504, 37160, 40328, 65672, 14984, 91016,
+    94184, 18152, 68840, 43496, 46664, 72008, 21320, 97352, 100520, 24488, 75176, 49832, 1456,
+    77488, 26800, 52144, 55312, 29968, 80656, 4624,  7792,  83824, 33136, 58480, 61648, 36304,
+    86992, 10960, 14128, 90160, 39472, 64816, 67984, 42640, 93328, 17296, 20464, 96496, 45808,
+    71152, 74320, 48976, 99664, 23632, 25944, 51288, 600,   76632, 79800, 3768,  54456, 29112,
+    32280, 57624, 6936,  82968, 86136, 10104, 60792, 35448, 38616, 63960, 13272, 89304, 92472,
+    16440, 67128, 41784, 44952, 70296, 19608, 95640, 98808, 22776, 73464, 48120};
+constexpr std::array<std::int32_t, 128> kQtLoop2{
+    2312,  78344, 27656, 53000, 56168, 30824, 81512, 5480,  8648,  84680, 33992, 59336, 62504,
+    37160, 87848, 11816, 14984, 91016, 40328, 65672, 68840, 43496, 94184, 18152, 21320, 97352,
+    46664, 72008, 75176, 49832, 100520, 24488, 0,    0,     0,     0,     0,     0,     0,
+    0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,
+    0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     0,     600,
+    76632, 25944, 51288, 54456, 29112, 79800, 3768,  6936,  82968, 32280, 57624, 60792, 35448,
+    86136, 10104, 13272, 89304, 38616, 63960, 67128, 41784, 92472, 16440, 19608, 95640, 44952,
+    70296, 73464, 48120, 98808, 22776, 26800, 52144, 1456,  77488, 80656, 4624,  55312, 29968,
+    33136, 58480, 7792,  83824, 86992, 10960, 61648, 36304, 39472, 64816, 14128, 90160, 93328,
+    17296, 67984, 42640, 45808, 71152, 20464, 96496, 99664, 23632, 74320, 48976};
+
+std::uint16_t u16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
+std::uint32_t u32(const std::uint8_t* p) {
+  return std::uint32_t(p[0]) | (std::uint32_t(p[1]) << 8) | (std::uint32_t(p[2]) << 16) |
+         (std::uint32_t(p[3]) << 24);
+}
+
+std::string hex(unsigned v, int digits) {
+  static constexpr char kDigits[] = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int i = digits - 1; i >= 0; --i) s += kDigits[(v >> (4 * i)) & 0xF];
+  return s;
+}
+
+std::string fail(const ModelSpec& spec, const std::string& what) {
+  return std::string(spec.name) + " packet: " + what;
+}
+
+// Slicing-by-16 tables for the non-reflected CRC-32/MPEG-2: t[s][i] is the CRC register after
+// byte i followed by s zero bytes.
+struct CrcTables {
+  std::array<std::array<std::uint32_t, 256>, 16> t{};
+  CrcTables() {
+    for (std::uint32_t i = 0; i < 256; ++i) {
+      std::uint32_t c = i << 24;
+      for (int k = 0; k < 8; ++k) c = (c & 0x80000000u) ? (c << 1) ^ 0x04C11DB7u : (c << 1);
+      t[0][i] = c;
+    }
+    for (std::uint32_t i = 0; i < 256; ++i)
+      for (int s = 1; s < 16; ++s) t[s][i] = (t[s - 1][i] << 8) ^ t[0][t[s - 1][i] >> 24];
+  }
+};
+const CrcTables& crcTables() {
+  static const CrcTables tables;
+  return tables;
+}
+
+// Days from 1970-01-01 to the given proleptic Gregorian date (era-based civil-date arithmetic).
+std::int64_t daysFromCivil(std::int64_t y, unsigned m, unsigned d) {
+  y -= m <= 2 ? 1 : 0;
+  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const unsigned yoe = static_cast<unsigned>(y - era * 400);
+  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
+}
+
+}  // namespace
+
+std::span<const ModelSpec> allModels() { return kModels; }
+
+const ModelSpec* findModel(std::string_view name) {
+  for (const ModelSpec& m : kModels)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+int returnsPerFiring(std::uint8_t mode) {
+  switch (mode) {
+    case return_mode::kFirst:
+    case return_mode::kSecond:
+    case return_mode::kStrongest:
+    case return_mode::kLast:
+      return 1;
+    case return_mode::kLastStrongest:
+    case return_mode::kFirstSecond:
+    case return_mode::kFirstLast:
+    case return_mode::kFirstStrongest:
+    case return_mode::kStrongestSecondStrongest:
+      return 2;
+    default:
+      return 0;
+  }
+}
+
+bool isGpsPacket(std::span<const std::uint8_t> payload) {
+  return payload.size() == 512 && payload[0] == 0xFF && payload[1] == 0xEE;
+}
+
+namespace {
+
+std::uint32_t crcTable(std::uint32_t c, const std::uint8_t* p, std::size_t n) {
+  const auto& t = crcTables().t;
+  while (n >= 16) {
+    const std::uint32_t a = c ^ ((std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) |
+                                 (std::uint32_t(p[2]) << 8) | std::uint32_t(p[3]));
+    c = t[15][a >> 24] ^ t[14][(a >> 16) & 0xFF] ^ t[13][(a >> 8) & 0xFF] ^ t[12][a & 0xFF] ^ t[11][p[4]] ^
+        t[10][p[5]] ^ t[9][p[6]] ^ t[8][p[7]] ^ t[7][p[8]] ^ t[6][p[9]] ^ t[5][p[10]] ^ t[4][p[11]] ^
+        t[3][p[12]] ^ t[2][p[13]] ^ t[1][p[14]] ^ t[0][p[15]];
+    p += 16;
+    n -= 16;
+  }
+  while (n--) c = (c << 8) ^ t[0][((c >> 24) ^ *p++) & 0xFF];
+  return c;
+}
+
+#if defined(__x86_64__)
+// Carry-less multiplication folding (the method of Intel's "Fast CRC Computation for Generic
+// Polynomials Using PCLMULQDQ", non-reflected form): 16 bytes at a time are folded into a 128-bit
+// remainder with x^192 mod P and x^128 mod P; the last remainder and the tail bytes go through the
+// table. Used when the CPU has PCLMULQDQ and SSSE3.
+std::uint64_t xPowModP(int n) {
+  std::uint64_t r = 1;
+  for (int i = 0; i < n; ++i) {
+    r <<= 1;
+    if (r & (std::uint64_t(1) << 32)) r ^= 0x104C11DB7ull;
+  }
+  return r;
+}
+
+__attribute__((target("pclmul,ssse3"))) std::uint32_t crcFold(const std::uint8_t* p, std::size_t n) {
+  static const __m128i k = _mm_set_epi64x(static_cast<long long>(xPowModP(192)), static_cast<long long>(xPowModP(128)));
+  const __m128i swap = _mm_set_epi8(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  __m128i x = _mm_shuffle_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)), swap);
+  x = _mm_xor_si128(x, _mm_set_epi32(-1, 0, 0, 0));  // the initial register 0xFFFFFFFF
+  p += 16;
+  n -= 16;
+  while (n >= 16) {
+    const __m128i next = _mm_shuffle_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)), swap);
+    x = _mm_xor_si128(_mm_xor_si128(_mm_clmulepi64_si128(x, k, 0x11), _mm_clmulepi64_si128(x, k, 0x00)), next);
+    p += 16;
+    n -= 16;
+  }
+  alignas(16) std::uint8_t rest[16];
+  _mm_store_si128(reinterpret_cast<__m128i*>(rest), _mm_shuffle_epi8(x, swap));
+  return crcTable(crcTable(0, rest, 16), p, n);
+}
+
+bool haveClmul() {
+  static const bool have = __builtin_cpu_supports("pclmul") && __builtin_cpu_supports("ssse3");
+  return have;
+}
+#endif
+
+}  // namespace
+
+std::uint32_t crc32Mpeg2(std::span<const std::uint8_t> bytes) {
+#if defined(__x86_64__)
+  if (bytes.size() >= 64 && haveClmul()) return crcFold(bytes.data(), bytes.size());
+#endif
+  return crcTable(0xFFFFFFFFu, bytes.data(), bytes.size());
+}
+
+std::optional<std::int64_t> utcSeconds(const std::array<std::uint8_t, 6>& d) {
+  const unsigned month = d[1], day = d[2], hour = d[3], minute = d[4], second = d[5];
+  if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 || second > 60)
+    return std::nullopt;
+  const std::int64_t days = daysFromCivil(1900 + std::int64_t(d[0]), month, day);
+  return days * 86400 + hour * 3600 + minute * 60 + second;
+}
+
+std::int32_t qt128LoopOffsetNs(int loop, int channel) {
+  if (channel < 0 || channel >= 128) return 0;
+  return loop == 1 ? kQtLoop1[channel] : kQtLoop2[channel];
+}
+
+std::int64_t firingOffsetNs(Model model, int returns, int block, int channel, std::uint8_t mode_flag) {
+  returns = returns == 2 ? 2 : 1;
+  switch (model) {
+    case Model::kXT16:
+    case Model::kXT32: {
+      // Firing rounds are 50 µs apart; t0 is the trigger of the last round (block 8, or 7 & 8).
+      const int rounds_after = (8 / returns - 1) - block / returns;
+      const std::int64_t block_start = 5'632 - 50'000 * std::int64_t(rounds_after);
+      const std::int64_t step = model == Model::kXT32 ? 1'512 : 3'024;
+      return block_start + 368 + step * channel;
+    }
+    case Model::kQT128: {
+      // One firing round is 111.11 µs (900 rounds per turn at 10 Hz).
+      const std::int64_t block_start = returns == 1 && block == 0 ? 9'000 - 111'110 : 9'000;
+      const int loop = returns == 1 ? block + 1 : ((mode_flag & 0x01) ? 1 : 2);
+      return block_start + qt128LoopOffsetNs(loop, channel);
+    }
+  }
+  return 0;
+}
+
+std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> payload, PacketView& v) {
+  const std::size_t size = payload.size();
+  const std::uint8_t* p = payload.data();
+  if (size < kHeaderBytes)
+    return fail(spec, "size " + std::to_string(size) + ", shorter than the 12-byte header");
+  if (p[0] != 0xEE || p[1] != 0xFF)
+    return fail(spec, "start of packet " + hex(unsigned(p[0]) << 8 | p[1], 4) + ", expected 0xEEFF");
+  if (p[2] != spec.protocol_major || p[3] != spec.protocol_minor)
+    return fail(spec, "protocol version " + std::to_string(p[2]) + "." + std::to_string(p[3]) +
+                          ", expected " + std::to_string(spec.protocol_major) + "." +
+                          std::to_string(spec.protocol_minor));
+  if (p[6] != spec.channels)
+    return fail(spec, "laser_num " + std::to_string(p[6]) + ", expected " + std::to_string(spec.channels));
+  if (p[7] != spec.blocks)
+    return fail(spec, "block_num " + std::to_string(p[7]) + ", expected " + std::to_string(spec.blocks));
+  if (p[9] == 0) return fail(spec, "dis_unit 0");
+  const std::uint8_t return_num = p[10];
+  if (return_num != 1 && return_num != 2)
+    return fail(spec, "return_num " + std::to_string(return_num) + ", expected 1 or 2");
+  const std::uint8_t flags = p[11];
+
+  v.body = p + kHeaderBytes;
+  v.channels = spec.channels;
+  v.blocks = spec.blocks;
+  v.returns = return_num;
+  v.dis_unit_mm = p[9];
+  const std::size_t body_bytes = std::size_t(spec.blocks) * v.blockBytes();
+  const std::size_t body_end = kHeaderBytes + body_bytes;
+
+  const std::uint8_t* tail = nullptr;
+  if (spec.protocol_major == 6) {
+    if (!(flags & 0x01)) return fail(spec, "flags " + hex(flags, 2) + " without the UDP sequence bit");
+    const std::size_t expected = body_end + kXtTailBytes + 4;
+    if (size != expected)
+      return fail(spec, "size " + std::to_string(size) + ", expected " + std::to_string(expected));
+    tail = p + body_end;
+    v.return_mode = tail[10];
+    v.motor_rpm = u16(tail + 11);
+    std::copy_n(tail + 13, 6, v.date.begin());
+    v.timestamp_us = u32(tail + 19);
+    v.udp_sequence = u32(tail + kXtTailBytes);
+    v.mode_flag = 0;
+    v.has_crc = false;
+    v.crc_ok = true;
+  } else {
+    if (flags & 0x02) return fail(spec, "flags " + hex(flags, 2) + " announce IMU fields (not supported)");
+    if (flags & 0x40)
+      return fail(spec, "flags " + hex(flags, 2) + " announce channel customization (not supported)");
+    const bool has_safety = flags & 0x04, has_sequence = flags & 0x01, has_signature = flags & 0x08;
+    const std::size_t tail_at = body_end + 4 + (has_safety ? kQtSafetyBytes : 0);
+    const std::size_t expected =
+        tail_at + kQtTailBytes + (has_sequence ? 4 : 0) + 4 + (has_signature ? kQtSignatureBytes : 0);
+    if (size != expected)
+      return fail(spec, "size " + std::to_string(size) + ", expected " + std::to_string(expected) +
+                            " for flags " + hex(flags, 2));
+    tail = p + tail_at;
+    v.mode_flag = tail[5];
+    v.return_mode = tail[12];
+    v.motor_rpm = u16(tail + 13);
+    std::copy_n(tail + 15, 6, v.date.begin());
+    v.timestamp_us = u32(tail + 21);
+    const std::size_t tail_end = kQtTailBytes + (has_sequence ? 4 : 0);
+    v.udp_sequence.reset();
+    if (has_sequence) v.udp_sequence = u32(tail + kQtTailBytes);
+    v.has_crc = true;
+    bool ok = crc32Mpeg2({v.body, body_bytes}) == u32(p + body_end);
+    if (has_safety) {
+      const std::uint8_t* fs = p + body_end + 4;
+      ok = ok && crc32Mpeg2({fs + 1, 12}) == u32(fs + 13);
+    }
+    ok = ok && crc32Mpeg2({tail, tail_end}) == u32(tail + tail_end);
+    v.crc_ok = ok;
+  }
+
+  const int n = returnsPerFiring(v.return_mode);
+  if (n == 0) return fail(spec, "return mode " + hex(v.return_mode, 2) + " unknown");
+  if (n != return_num)
+    return fail(spec, "return mode " + hex(v.return_mode, 2) + " has " + std::to_string(n) +
+                          " returns, header return_num " + std::to_string(return_num));
+  if (v.timestamp_us > 1'000'000)
+    return fail(spec, "timestamp " + std::to_string(v.timestamp_us) + " us, above 1000000");
+  for (int b = 0; b < v.blocks; ++b) {
+    const std::uint16_t az = v.azimuth(b);
+    if (az >= 36000)
+      return fail(spec, "block " + std::to_string(b + 1) + " azimuth " + std::to_string(az) +
+                            ", above 35999 (0.01 deg)");
+    if (b % n != 0 && az != v.azimuth(b - b % n))
+      return fail(spec, "block " + std::to_string(b + 1) + " azimuth " + std::to_string(az) +
+                            " differs from its dual-return partner " +
+                            std::to_string(v.azimuth(b - b % n)));
+  }
+  return {};
+}
+
+}  // namespace rigcal::drivers::hesai
