@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   app.footer(kExitCodesHelp);
 
   addCheckConfigCommand(app);
+  addReplayCommand(app);
 
   try {
     app.parse(argc, argv);
