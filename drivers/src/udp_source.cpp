@@ -260,13 +260,16 @@ std::optional<UdpPacket> UdpSource::next() {
       ++stats_.packets;
       return packet;
     }
-    if (receiveBatch()) continue;
+    // The batch is used up. The clock is read once per batch, not per datagram; the deadline also
+    // bounds a next() that only sees datagrams the filter rejects.
     const auto now = Clock::now();
-    if (!deadline) deadline = now + config_.timeout;
-    if (now >= *deadline) {
+    if (!deadline) {
+      deadline = now + config_.timeout;
+    } else if (now >= *deadline) {
       refreshKernelDrops();
       return std::nullopt;
     }
+    if (receiveBatch()) continue;
     const auto left = std::chrono::ceil<std::chrono::milliseconds>(*deadline - now);
     if (!waitReadable(int(left.count()))) {
       if (stopped()) return std::nullopt;

@@ -2,10 +2,31 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <new>
 #include <random>
 
 #include "rigcal/drivers/scan_assembler.hpp"
+
+#if defined(__GNUC__) && !defined(__clang__)
+// GCC pairs the replaced operator new with free() below after inlining and warns; they do match.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
+
+// Counts heap allocations, to check that the reorder window allocates nothing in steady state.
+namespace {
+std::atomic<std::uint64_t> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace rigcal::drivers {
 namespace {
@@ -143,6 +164,34 @@ TEST(ScanAssemblerReorder, FlushStartsAFreshOrderForTheNextInput) {
   std::size_t points = 0;
   for (const Scan& s : scans) points += s.size();
   EXPECT_EQ(points, 20u * 36u);
+}
+
+TEST(ScanAssemblerReorder, SteadyStateAllocatesNothingBetweenSweeps) {
+  std::vector<Scan> scans;
+  scans.reserve(16);
+  AssemblerConfig config{90.0};
+  ScanAssembler a("s", config, [&](Scan&& s) { scans.push_back(std::move(s)); });
+  // Packets of one turn cover 0..359°; the cut at 90° falls in packet k%10 == 2.
+  std::vector<DecodedPacket> packets;
+  for (int k = 0; k < 60; ++k) packets.push_back(streamPacket(k));
+  std::vector<int> order = inOrder(60);
+  std::mt19937 rng(3);
+  for (std::size_t b = 0; b < order.size(); b += 4)
+    std::shuffle(order.begin() + std::ptrdiff_t(b), order.begin() + std::ptrdiff_t(b + 4), rng);
+  // Arrival i releases packet i - 8 (nothing is late). Up to arrival 30 (releasing packet 22, which
+  // holds the third cut), two full turns warm the window's and the sweep's buffers up.
+  std::size_t i = 0;
+  for (; i <= 30; ++i) a.add(packets[std::size_t(order[i])]);
+  const std::size_t scans_before = scans.size();
+  // Arrivals 31..39 release packets 23..31: no cut, so nothing may allocate.
+  const std::uint64_t before = g_allocations.load();
+  for (; i < 40; ++i) a.add(packets[std::size_t(order[i])]);
+  const std::uint64_t during = g_allocations.load() - before;
+  EXPECT_EQ(scans.size(), scans_before) << "no sweep was emitted in the measured stretch";
+  EXPECT_EQ(during, 0u) << "add() allocated in steady state";
+  for (; i < 60; ++i) a.add(packets[std::size_t(order[i])]);
+  a.flush();
+  EXPECT_EQ(a.stats().late_dropped, 0u);
 }
 
 TEST(ScanAssemblerReorder, MalformedAndIgnoredPacketsBypassTheWindow) {
