@@ -252,7 +252,7 @@ std::optional<UdpPacket> UdpSource::next() {
       if (packet.receive_ns == 0) packet.receive_ns = realtimeNow();
       packet.source = {ntohl(addresses_[i].sin_addr.s_addr), ntohs(addresses_[i].sin_port)};
       packet.payload = {data_.data() + i * config_.max_datagram, messages_[i].msg_len};
-      // The port is the socket's own; only the source address (and port) filter applies.
+      // The destination port is the socket's own: only the source-address filter applies.
       if (config_.filter.source_address && packet.source.address != *config_.filter.source_address) {
         ++stats_.filtered;
         continue;
