@@ -222,13 +222,6 @@ void checkConsistency(const Reader& r, const YAML::Node& root, const RigConfig& 
 
 namespace {
 
-// yaml-cpp quotes an offending character raw (e.g. a newline after a backslash): keep errors one line.
-std::string oneLine(std::string text) {
-  for (char& c : text)
-    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
-  return text;
-}
-
 RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file)) throw ConfigError({file}, "rig file not found");
   const Reader r(file);
@@ -236,7 +229,7 @@ RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
   try {
     root = YAML::LoadFile(file.string());
   } catch (const YAML::Exception& e) {
-    throw ConfigError({file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + oneLine(e.msg));
+    throw ConfigError({file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + e.msg);
   }
   r.requireMap(root, "a rig file");
   r.checkKeys(root, {"rig", "sensors", "roles", "initial_extrinsics", "parameters"}, "the rig file");
@@ -302,7 +295,7 @@ RigConfig loadRigConfig(const std::filesystem::path& file) {
   } catch (const YAML::Exception& e) {
     // A node of the wrong kind where a plain value is read (e.g. a complex mapping key `? [a]`).
     throw ConfigError({file, e.mark.line + 1, e.mark.column + 1},
-                      "expected a plain value here (" + oneLine(e.msg) + ")");
+                      "expected a plain value here (" + e.msg + ")");
   }
 }
 
