@@ -6,7 +6,7 @@ TSAN      ?= build-tsan
 GENERATOR := $(shell command -v ninja >/dev/null 2>&1 && echo "-G Ninja")
 CTEST     := ctest --output-on-failure --timeout 600 -j $(JOBS)
 
-.PHONY: deps build test test-release test-asan test-tsan demo bench clean
+.PHONY: deps build test test-release test-asan test-tsan demo bench fuzz clean
 
 deps:
 	@scripts/install-deps
@@ -39,6 +39,10 @@ demo: build
 
 bench: build
 	@scripts/run-benchmarks $(BUILD)
+
+# Every libFuzzer harness (clang, ASan+UBSan) for FUZZ_SECONDS each (default 30), in build-fuzz.
+fuzz: deps
+	@scripts/run-fuzzers $(FUZZ_SECONDS)
 
 clean:
 	rm -rf $(BUILD) $(ASAN) $(TSAN)

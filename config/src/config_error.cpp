@@ -13,8 +13,17 @@ std::string SourceLocation::str() const {
   return s.str();
 }
 
+namespace {
+// Messages quote the user's text (keys, values, yaml-cpp's offending character): keep them one line.
+std::string oneLine(std::string text) {
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  return text;
+}
+}  // namespace
+
 ConfigError::ConfigError(const SourceLocation& where, const std::string& what)
-    : std::runtime_error(where.str() + ": " + what), where_(where) {}
+    : std::runtime_error(oneLine(where.str() + ": " + what)), where_(where) {}
 
 namespace {
 std::size_t editDistance(const std::string& a, const std::string& b) {

@@ -220,7 +220,9 @@ void checkConsistency(const Reader& r, const YAML::Node& root, const RigConfig& 
 
 }  // namespace
 
-RigConfig loadRigConfig(const std::filesystem::path& file) {
+namespace {
+
+RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file)) throw ConfigError({file}, "rig file not found");
   const Reader r(file);
   YAML::Node root;
@@ -283,6 +285,18 @@ RigConfig loadRigConfig(const std::filesystem::path& file) {
   if (const YAML::Node params = root["parameters"]) readParameters(r, params, rig.parameters, rig.warnings);
   checkConsistency(r, root, rig);
   return rig;
+}
+
+}  // namespace
+
+RigConfig loadRigConfig(const std::filesystem::path& file) {
+  try {
+    return loadRigConfigUnchecked(file);
+  } catch (const YAML::Exception& e) {
+    // A node of the wrong kind where a plain value is read (e.g. a complex mapping key `? [a]`).
+    throw ConfigError({file, e.mark.line + 1, e.mark.column + 1},
+                      "expected a plain value here (" + e.msg + ")");
+  }
 }
 
 }  // namespace rigcal::config

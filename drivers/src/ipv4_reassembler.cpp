@@ -35,7 +35,8 @@ std::span<const std::uint8_t> Ipv4Reassembler::add(const Ipv4Header& f) {
     p.data.resize(end);
     p.have.resize((end + 7) / 8, false);
   }
-  std::memcpy(p.data.data() + begin, f.payload.data(), f.payload.size());
+  // An empty fragment is legal on the wire; memcpy with a null pointer is not, even for 0 bytes.
+  if (!f.payload.empty()) std::memcpy(p.data.data() + begin, f.payload.data(), f.payload.size());
   for (std::size_t block = begin / 8; block < (end + 7) / 8; ++block) {
     if (!p.have[block]) {
       p.have[block] = true;

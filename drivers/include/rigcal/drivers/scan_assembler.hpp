@@ -2,6 +2,11 @@
 // Cuts the stream of decoded packets into full sweeps. A sweep ends where the sensor's own frame id
 // changes (Ouster), or else where the rotor azimuth crosses the cut angle (Velodyne, Hesai). Sweeps
 // that straddle packets are handled point by point; a gap in time also ends a sweep.
+// Packets may arrive slightly out of order (UDP): a small reorder window holds the latest
+// `reorder_window` data packets sorted by DecodedPacket::order_key and releases the oldest when it is
+// full (all of them on flush). A packet older than one already released is dropped and counted; more
+// such packets in a row than the window holds mean the key restarted (sensor reboot, counter wrap), and
+// ordering starts afresh. Steady state allocates nothing: the window's packet buffers are reused.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -17,6 +22,7 @@ struct AssemblerConfig {
   double cut_angle_deg = 0.0;           // azimuth at which a sweep starts, in [0, 360)
   TimeNs max_packet_gap_ns = 200 * kNsPerMs;  // a silence this long ends the sweep in progress
   std::size_t min_points = 1;           // shorter sweeps (e.g. empty) are not emitted
+  std::size_t reorder_window = 8;       // data packets held to undo reordering; 0 = none
 };
 
 struct AssemblerStats {
@@ -25,6 +31,10 @@ struct AssemblerStats {
   std::uint64_t ignored = 0;
   std::uint64_t lost_packets = 0;
   std::uint64_t scans = 0;
+  std::uint64_t reordered = 0;          // data packets that arrived after one with a larger order_key
+  std::uint64_t late_dropped = 0;       // data packets older than one already released: dropped
+  std::uint64_t key_resets = 0;         // order_key went back for good (more late packets in a row
+                                        // than the window): ordering restarted from there
   std::string last_error;               // the latest malformed packet's reason
 };
 
@@ -36,12 +46,20 @@ class ScanAssembler {
 
   /// Feeds one decoded packet; completed sweeps are passed to the callback, in order.
   void add(const DecodedPacket& packet);
-  /// End of input: emits the sweep in progress (a partial sweep is still a sweep).
+  /// Same, without copying the points: `packet` is swapped with a recycled buffer of the reorder
+  /// window (its content afterwards is unspecified; decoders reset() it before decoding).
+  void add(DecodedPacket&& packet);
+  /// End of input: releases the reorder window and emits the sweep in progress (a partial sweep is
+  /// still a sweep).
   void flush();
   [[nodiscard]] const AssemblerStats& stats() const { return stats_; }
 
  private:
   [[nodiscard]] bool crossesCut(float from_deg, float to_deg) const;
+  bool admit(const DecodedPacket& packet);  // counts; false when the packet goes no further
+  void hold(std::size_t slot);              // inserts a filled slot into the window
+  void releaseOldest();
+  void process(const DecodedPacket& packet);
   void emit();
 
   std::string sensor_id_;
@@ -55,6 +73,15 @@ class ScanAssembler {
   std::optional<std::uint64_t> frame_id_;
   std::optional<TimeNs> last_packet_time_;
   std::uint64_t sequence_ = 0;
+
+  // Reorder window: slots_ holds reorder_window + 1 reusable packets; window_ lists the held slots in
+  // order_key order (stable for equal keys), free_ the unused ones.
+  std::vector<DecodedPacket> slots_;
+  std::vector<std::size_t> window_;
+  std::vector<std::size_t> free_;
+  std::optional<std::uint64_t> released_key_;  // order_key of the latest released packet
+  std::optional<std::uint64_t> max_key_;       // largest order_key seen
+  std::size_t consecutive_late_ = 0;
 };
 
 }  // namespace rigcal::drivers
