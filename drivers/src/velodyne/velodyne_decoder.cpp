@@ -89,6 +89,25 @@ TimeNs HourResolver::resolve(std::uint32_t micros_past_hour, TimeNs reference_ns
 
 namespace {
 
+// cos and sin of every azimuth in 0.01° steps, shared by all decoders.
+struct AzimuthTable {
+  std::vector<float> cos, sin;
+};
+const AzimuthTable& azimuthTable() {
+  static const AzimuthTable table = [] {
+    AzimuthTable t;
+    t.cos.resize(kAzimuthUnits);
+    t.sin.resize(kAzimuthUnits);
+    for (int i = 0; i < kAzimuthUnits; ++i) {
+      const double a = i * (std::numbers::pi / 18000.0);
+      t.cos[i] = static_cast<float>(std::cos(a));
+      t.sin[i] = static_cast<float>(std::sin(a));
+    }
+    return t;
+  }();
+  return table;
+}
+
 struct LaserTerms {
   float cos_vert, sin_vert;  // elevation
   float cos_rot, sin_rot;    // azimuth correction (subtracted)
@@ -103,13 +122,6 @@ class VelodyneDecoder final : public PacketDecoder {
                   const VelodyneOptions& options)
       : model_(model), info_(modelInfo(model)), options_(options), time_source_(config.time_source),
         min_range_(decimalLimit(config.min_range_m)), max_range_(decimalLimit(config.max_range_m)) {
-    cos_az_.resize(kAzimuthUnits);
-    sin_az_.resize(kAzimuthUnits);
-    for (int i = 0; i < kAzimuthUnits; ++i) {
-      const double a = i * (std::numbers::pi / 18000.0);
-      cos_az_[i] = static_cast<float>(std::cos(a));
-      sin_az_[i] = static_cast<float>(std::sin(a));
-    }
     for (const LaserCorrection& l : calibration.lasers)
       lasers_.push_back(LaserTerms{
           static_cast<float>(std::cos(l.vert_correction_rad)),
@@ -199,7 +211,8 @@ class VelodyneDecoder final : public PacketDecoder {
   VelodyneOptions options_;
   TimeSource time_source_;
   double min_range_, max_range_;
-  std::vector<float> cos_az_, sin_az_;
+  const float* cos_az_ = azimuthTable().cos.data();
+  const float* sin_az_ = azimuthTable().sin.data();
   std::vector<LaserTerms> lasers_;
   std::int32_t offset_ns_[2][kBlocksPerPacket][4][kChannelsPerBlock];
   float fraction_[4][kChannelsPerBlock];
@@ -426,8 +439,22 @@ void VelodyneDecoder::decode(const UdpPacket& packet, DecodedPacket& out) {
 }  // namespace
 }  // namespace velodyne
 
-std::unique_ptr<PacketDecoder> makeVelodyneDecoder(const DecoderConfig& config,
-                                                   const VelodyneOptions& options) {
+namespace velodyne {
+
+std::unique_ptr<PacketDecoder> makeDecoder(Model model, const Calibration& calibration, const DecoderConfig& config,
+                                           const VelodyneOptions& options) {
+  const ModelInfo& info = modelInfo(model);
+  if (calibration.lasers.size() != static_cast<std::size_t>(info.lasers))
+    throw std::runtime_error(calibration.source + ": lasers: " + std::to_string(calibration.lasers.size()) +
+                             " entries, " + info.name + " has " + std::to_string(info.lasers) + " lasers");
+  if (!(config.min_range_m >= 0 && config.max_range_m > config.min_range_m))
+    throw std::runtime_error(std::string(info.name) + ": min_range/max_range: need 0 <= min < max");
+  return std::make_unique<VelodyneDecoder>(model, calibration, config, options);
+}
+
+}  // namespace velodyne
+
+std::unique_ptr<PacketDecoder> makeVelodyneDecoder(const DecoderConfig& config, const VelodyneOptions& options) {
   using namespace velodyne;
   const std::optional<Model> model = parseModel(config.model);
   if (!model) {
@@ -435,19 +462,14 @@ std::unique_ptr<PacketDecoder> makeVelodyneDecoder(const DecoderConfig& config,
     for (const std::string& m : modelNames()) known += (known.empty() ? "" : ", ") + m;
     throw std::runtime_error("unknown Velodyne model '" + config.model + "' (known: " + known + ")");
   }
-  if (!(config.min_range_m >= 0 && config.max_range_m > config.min_range_m))
-    throw std::runtime_error(std::string(modelInfo(*model).name) +
-                             ": min_range/max_range: need 0 <= min < max");
-  Calibration calibration;
-  if (!config.calibration.empty()) {
-    calibration = loadCalibration(config.calibration, *model);
-  } else if (auto nominal = nominalCalibration(*model)) {
-    calibration = std::move(*nominal);
-  } else {
-    throw std::runtime_error(std::string(modelInfo(*model).name) +
-                             ": calibration: a calibration file is required (no nominal table built in)");
-  }
-  return std::make_unique<VelodyneDecoder>(*model, calibration, config, options);
+  if (!config.calibration.empty()) return makeDecoder(*model, loadCalibration(config.calibration, *model), config, options);
+  if (auto nominal = nominalCalibration(*model)) return makeDecoder(*model, *nominal, config, options);
+  throw std::runtime_error(std::string(modelInfo(*model).name) +
+                           ": calibration: a calibration file is required (no nominal table built in)");
+}
+
+std::unique_ptr<PacketDecoder> makeVelodyneDecoder(const DecoderConfig& config) {
+  return makeVelodyneDecoder(config, VelodyneOptions{});
 }
 
 std::vector<std::string> velodyneModels() { return velodyne::modelNames(); }

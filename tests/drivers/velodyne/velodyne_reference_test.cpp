@@ -295,3 +295,40 @@ TEST(VelodyneReference, Hdl32eDecodesCleanly) {
 
 }  // namespace
 }  // namespace rigcal::drivers
+
+namespace rigcal::drivers {
+namespace {
+
+// Packets removed from a real capture are reported as lost, and only they.
+TEST(VelodyneReference, PacketsRemovedFromACaptureAreCountedAsLost) {
+  RIGCAL_REQUIRE_DATA(dir, "velodyne");
+  struct Case {
+    std::string pcap, model, calibration;
+  };
+  for (const Case& c : {Case{"vlp16_dual.pcap", "VLP-16", ""}, Case{"vlp32c_fov270to90.pcap", "VLP-32C", ""},
+                        Case{"vls128_strongest.pcap", "VLS-128", "VLS128.calibration.yaml"},
+                        Case{"hdl32e_example.pcap", "HDL-32E", ""}}) {
+    DecoderConfig config;
+    config.model = c.model;
+    if (!c.calibration.empty()) config.calibration = dir / c.calibration;
+    auto decoder = makeVelodyneDecoder(config);
+    PcapSource source(dir / c.pcap);
+    DecodedPacket out;
+    std::uint64_t lost = 0, removed = 0, data = 0;
+    while (auto p = source.next()) {
+      if (p->payload.size() != 1206) continue;
+      ++data;
+      if (data > 1 && (data % 97 == 0 || data % 251 == 0 || data % 251 == 1)) {  // singles and pairs
+        ++removed;
+        continue;
+      }
+      decoder->decode(*p, out);
+      lost += out.lost_before;
+    }
+    EXPECT_GE(removed, 5u);
+    EXPECT_EQ(lost, removed) << c.pcap;
+  }
+}
+
+}  // namespace
+}  // namespace rigcal::drivers

@@ -30,13 +30,20 @@ struct VelodyneOptions {
 /// Builds a Velodyne decoder. `config.calibration` is a ROS YAML or VeloView XML file; when empty the
 /// manual's nominal table is used (VLP-16, VLP-32C, HDL-32E; the VLS-128 requires a file). Throws
 /// std::runtime_error naming the model, or the file and its bad field.
-std::unique_ptr<PacketDecoder> makeVelodyneDecoder(const DecoderConfig& config,
-                                                   const VelodyneOptions& options = {});
+std::unique_ptr<PacketDecoder> makeVelodyneDecoder(const DecoderConfig& config);
+std::unique_ptr<PacketDecoder> makeVelodyneDecoder(const DecoderConfig& config, const VelodyneOptions& options);
 
 /// The model names makeVelodyneDecoder accepts.
 std::vector<std::string> velodyneModels();
 
 namespace velodyne {
+
+struct Calibration;
+enum class Model : std::uint8_t;
+
+/// The same from an already loaded calibration (its laser count must be the model's).
+std::unique_ptr<PacketDecoder> makeDecoder(Model model, const Calibration& calibration, const DecoderConfig& config,
+                                           const VelodyneOptions& options = {});
 
 /// Resolves a Velodyne timestamp (µs past the top of the hour) to absolute time, taking the hour from
 /// a reference clock (the receive time). The first packet takes the hour that puts the sensor time
