@@ -2,7 +2,6 @@
 
 #include <fstream>
 #include <numbers>
-#include <regex>
 #include <sstream>
 
 #include "rigcal/drivers/velodyne/velodyne_calibration.hpp"
@@ -37,6 +36,14 @@ std::string loadError(const std::filesystem::path& file, Model model) {
   }
   ADD_FAILURE() << file << " was accepted";
   return {};
+}
+
+// `text` with the first occurrence of `from` replaced by `to` (the text must contain it).
+std::string replaceFirst(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
 }
 
 void expectSame(const Calibration& a, const Calibration& b, double tolerance) {
@@ -136,17 +143,16 @@ TEST(VelodyneCalibration, MalformedYamlIsRejectedNamingFileAndField) {
   EXPECT_NE(loadError(writeText(tmp, "empty.yaml", ""), Model::kVlp16).find("lasers"), std::string::npos);
 
   // A value that is not a number, a duplicate id, degrees in a radians file, a wrong num_lasers.
-  std::string text = std::regex_replace(good, std::regex("rot_correction: 0.0,"), "rot_correction: abc,",
-                                        std::regex_constants::format_first_only);
+  std::string text = replaceFirst(good, "rot_correction: 0.0,", "rot_correction: abc,");
   EXPECT_NE(loadError(writeText(tmp, "nan.yaml", text), Model::kVlp16).find("lasers[0].rot_correction: not a number"),
             std::string::npos);
-  text = std::regex_replace(good, std::regex("laser_id: 5,"), "laser_id: 4,");
+  text = replaceFirst(good, "laser_id: 5,", "laser_id: 4,");
   EXPECT_NE(loadError(writeText(tmp, "dup.yaml", text), Model::kVlp16).find("laser_id: duplicate id 4"),
             std::string::npos);
-  text = std::regex_replace(good, std::regex("vert_correction: -0.2617993877991494,"), "vert_correction: -15,");
+  text = replaceFirst(good, "vert_correction: -0.2617993877991494,", "vert_correction: -15,");
   EXPECT_NE(loadError(writeText(tmp, "degrees.yaml", text), Model::kVlp16).find("lasers[0].vert_correction"),
             std::string::npos);
-  text = std::regex_replace(good, std::regex("num_lasers: 16"), "num_lasers: 32");
+  text = replaceFirst(good, "num_lasers: 16", "num_lasers: 32");
   EXPECT_NE(loadError(writeText(tmp, "count.yaml", text), Model::kVlp16).find("num_lasers: 32 lasers, VLP-16 has 16"),
             std::string::npos);
   // A file that does not exist.
@@ -181,9 +187,8 @@ TEST(VelodyneCalibration, MalformedXmlIsRejectedNamingFileAndField) {
   EXPECT_NE(loadError(writeText(tmp, "other.xml", "<?xml version=\"1.0\"?><root><a>1</a></root>"), Model::kVlp16)
                 .find("DB: missing"),
             std::string::npos);
-  const std::string nan = std::regex_replace(good, std::regex("<rotCorrection_>0</rotCorrection_>"),
-                                             "<rotCorrection_>zero</rotCorrection_>",
-                                             std::regex_constants::format_first_only);
+  const std::string nan =
+      replaceFirst(good, "<rotCorrection_>0</rotCorrection_>", "<rotCorrection_>zero</rotCorrection_>");
   EXPECT_NE(loadError(writeText(tmp, "nan.xml", nan), Model::kVlp16).find("points_[0].rotCorrection_: not a number"),
             std::string::npos);
 }
