@@ -170,7 +170,7 @@ class VelodyneDecoder final : public PacketDecoder {
   [[nodiscard]] TimeNs skippedNs(int hundredths, float step) const {
     const double seconds = rate_hz_ > 0 ? hundredths / double(kAzimuthUnits) / rate_hz_ - sequence_us_ * 1e-6
                                         : (hundredths - double(step)) / step * sequence_us_ * 1e-6;
-    return std::llround(seconds * 1e9);
+    return std::llround(std::clamp(seconds, 0.0, 1.0) * 1e9);  // a dead sector lasts under a turn
   }
 
   // nebula's per-channel multiplier of the block's azimuth step (see nebulaAzimuth).
@@ -362,7 +362,7 @@ void VelodyneDecoder::decode(const UdpPacket& packet, DecodedPacket& out) {
       const int advance = (azimuth[0] - previous_first_azimuth_ + kAzimuthUnits) % kAzimuthUnits;
       if (dt > 0 && advance > 0) {
         const double hz = double(advance) / kAzimuthUnits / toSeconds(dt);
-        rate_hz_ = rate_hz_ > 0 ? 0.95 * rate_hz_ + 0.05 * hz : hz;
+        if (hz > 1.0 && hz < 2 * kMaxRpm / 60.0) rate_hz_ = rate_hz_ > 0 ? 0.95 * rate_hz_ + 0.05 * hz : hz;
       }
     }
   }
