@@ -5,6 +5,7 @@
 #include "rigcal/drivers/hesai/hesai_decoder.hpp"
 #include "rigcal/drivers/ouster/ouster_decoder.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
+#include "rigcal/drivers/velodyne/velodyne_decoder.hpp"
 
 namespace rigcal::drivers {
 
@@ -16,6 +17,7 @@ struct Vendor {
 
 const std::vector<Vendor>& vendors() {
   static const std::vector<Vendor> table = {
+      {velodyneModels, [](const DecoderConfig& c) { return makeVelodyneDecoder(c); }},
       {ousterModels, makeOusterDecoder},
       {hesaiModels, makeHesaiDecoder},
   };

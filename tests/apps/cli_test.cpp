@@ -55,6 +55,20 @@ TEST(Cli, DecodeWritesOneFilePerScanAndSummarises) {
   EXPECT_EQ(header, "x,y,z,intensity,ring,offset_ns");
 }
 
+TEST(Cli, DecodeHandlesEveryVendor) {
+  RIGCAL_REQUIRE_DATA(vlp16, "velodyne/vlp16_dual.pcap");
+  TempDir out;
+  const auto v = runRigcal({"decode", vlp16.string(), "--sensor", "VLP-16", "--out", (out / "v").string()});
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  EXPECT_NE(v.out.find("decoded 5 scans"), std::string::npos) << v.out;  // 3 full turns + 2 partial ends
+  const auto xt32 = dataDir() / "hesai/xt32_dual.pcap";
+  const auto h = runRigcal({"decode", xt32.string(), "--sensor", "PandarXT32", "--calibration",
+                            (dataDir() / "hesai/PandarXT32.csv").string(), "--out", (out / "h").string()});
+  ASSERT_EQ(h.exit_code, 0) << h.err;
+  EXPECT_NE(h.out.find("(0 malformed"), std::string::npos) << h.out;
+  EXPECT_TRUE(std::filesystem::exists(out / "h" / "scan_000002.pcd"));
+}
+
 TEST(Cli, DecodeInputErrorsAreOneLineWithExitCode4) {
   RIGCAL_REQUIRE_DATA(pcap, "ouster/OS-2-128-U1_v2.3.0_1024x10.pcap");
   TempDir out;
