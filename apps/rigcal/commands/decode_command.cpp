@@ -12,6 +12,7 @@
 #include "rigcal/drivers/packet_decoder.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
 #include "rigcal/drivers/scan_assembler.hpp"
+#include "rigcal/drivers/scan_pump.hpp"
 
 namespace rigcal::app {
 
@@ -71,14 +72,7 @@ void run(const DecodeOptions& o) {
               << scan.missing_packets << '\n';
     ++written;
   });
-  drivers::DecodedPacket decoded;
-  while (auto packet = source->next()) {
-    decoder->decode(*packet, decoded);
-    assembler.add(decoded);
-  }
-  decoder->flush(decoded);
-  if (!decoded.points.empty()) assembler.add(decoded);
-  assembler.flush();
+  drivers::pumpScans(*source, *decoder, assembler);
 
   const auto& a = assembler.stats();
   const auto& s = source->stats();
