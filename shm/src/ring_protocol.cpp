@@ -169,8 +169,7 @@ std::uint64_t beginPublish(const RingView& ring) {
   return index;
 }
 
-void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch,
-                  std::int64_t publish_ns) {
+void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch) {
   SlotHeader& s = ring.slotHeader(index);
   const SlotGeometry& g = ring.geometry();
   const auto n = static_cast<std::uint32_t>(scan.size());
@@ -188,15 +187,16 @@ void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, s
   s.sensor_sequence.store(scan.sequence, kRelease);
   s.stamp_ns.store(scan.stamp_ns, kRelease);
   s.missing_packets.store(scan.missing_packets, kRelease);
-  s.publish_ns.store(publish_ns, kRelease);
   s.epoch.store(epoch, kRelease);
   s.checksum.store(sum.value(), kRelease);
 }
 
 void commitPublish(const RingView& ring, std::uint64_t index, const Scan& scan) {
   RingHeader& h = ring.header();
-  ring.slotHeader(index).seq.store(2 * index + 2, kRelease);
+  SlotHeader& s = ring.slotHeader(index);
   const std::int64_t now = monotonicNs();
+  s.publish_ns.store(now, kRelease);
+  s.seq.store(2 * index + 2, kRelease);
   h.last_stamp_ns.store(scan.stamp_ns, kRelaxed);
   h.total_points.store(h.total_points.load(kRelaxed) + scan.size(), kRelaxed);
   h.heartbeat_ns.store(now, kRelaxed);
@@ -216,9 +216,8 @@ void wakeReaders(const RingView& ring) {
 }
 
 std::uint64_t publishScan(const RingView& ring, const Scan& scan, std::uint64_t epoch) {
-  const std::int64_t started = monotonicNs();
   const std::uint64_t index = beginPublish(ring);
-  writePayload(ring, index, scan, epoch, started);
+  writePayload(ring, index, scan, epoch);
   commitPublish(ring, index, scan);
   return index;
 }

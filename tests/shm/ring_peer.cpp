@@ -2,11 +2,14 @@
 // only through the ring and one-line "key=value" reports on stdout.
 //
 //   ring_peer writer --prefix P --sensor S --points N [--slots K] [--count C] [--rate HZ] [--first-seq F]
-//                    [--start-delay-ms D] [--stall-after M] [--hold]
+//                    [--start-delay-ms D] [--stall-after M] [--hold] [--wait-readers R]
 //   ring_peer reader --prefix P --sensor S --points N [--count C] [--timeout-ms T] [--delay-ms D]
 //                    [--oldest] [--until-closed]
 //
-// Scans follow scan_pattern.hpp, so the reader checks every value of every scan it gets.
+// Scans follow scan_pattern.hpp, so the reader checks every value of every scan it gets. --wait-readers R
+// is test-only flow control (the ring itself never waits for readers): the writer waits for R readers to
+// attach, and after each publish until they have read it, so a loaded machine cannot turn an exchange test
+// into an overrun test. A reader stops once it has accounted for --count ring indices (read or lost).
 #include <signal.h>
 #include <unistd.h>
 
@@ -67,6 +70,27 @@ void sleepUntil(std::int64_t mono_ns) {
   }
 }
 
+/// Live reader records: how many, and how many of them have not read up to `index` yet.
+std::pair<int, int> readers(const ScanRingWriter& w, std::uint64_t index) {
+  int live = 0, behind = 0;
+  for (const ReaderRecord& r : w.view().header().readers) {
+    if (r.pid.load() <= 0) continue;
+    ++live;
+    if (r.next_index.load() < index) ++behind;
+  }
+  return {live, behind};
+}
+
+/// Polls every millisecond, at most 5 s, until `count` readers are attached and none is behind `index`
+/// (a reader that has finished and left is not behind).
+void waitForReaders(const ScanRingWriter& w, int count, std::uint64_t index, bool first) {
+  for (int i = 0; i < 5000; ++i) {
+    const auto [live, behind] = readers(w, index);
+    if ((!first || live >= count) && behind == 0) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
 int runWriter(const Args& a) {
   WriterOptions options;
   options.sensor = a.str("sensor", "lidar");
@@ -82,6 +106,8 @@ int runWriter(const Args& a) {
   const long long first = a.num("first-seq", 0);
   const long long stall_after = a.num("stall-after", -1);
   const double rate = static_cast<double>(a.num("rate", 0));
+  const int wait_readers = static_cast<int>(a.num("wait-readers", 0));
+  if (wait_readers > 0) waitForReaders(writer, wait_readers, writer.view().header().write_index.load(), true);
   Scan scan;
   const std::int64_t t0 = monotonicNs();
   for (long long k = 0; k < count; ++k) {
@@ -90,12 +116,13 @@ int runWriter(const Args& a) {
     if (k == stall_after) {
       // Die mid-write: the slot counter is odd and half the slot is overwritten when the test kills us.
       const std::uint64_t index = beginPublish(writer.view());
-      writePayload(writer.view(), index, scan, writer.epoch(), monotonicNs());
+      writePayload(writer.view(), index, scan, writer.epoch());
       say("midwrite index=" + std::to_string(index));
       for (;;) ::pause();
     }
     if (rate > 0) sleepUntil(t0 + static_cast<std::int64_t>(static_cast<double>(k) * 1e9 / rate));
     writer.publish(scan);
+    if (wait_readers > 0) waitForReaders(writer, wait_readers, writer.view().header().write_index.load(), false);
   }
   const double elapsed_ms = static_cast<double>(monotonicNs() - t0) * 1e-6;
   say("published n=" + std::to_string(writer.stats().published) +
@@ -134,7 +161,9 @@ int runReader(const Args& a) {
   std::set<std::uint64_t> epochs;
   std::string last_report;
   std::int64_t next_status_check = 0;
-  while (monotonicNs() < deadline && (count <= 0 || good + bad < count)) {
+  const ReaderStats& s = reader.stats();
+  const auto accounted = [&] { return good + bad + static_cast<long long>(s.overruns + s.checksum_errors); };
+  while (monotonicNs() < deadline && (count <= 0 || accounted() < count)) {
     const ReadStatus got = reader.read(scan, std::chrono::milliseconds(50), &meta);
     if (got == ReadStatus::kScan) {
       const std::string why = test::checkPattern(scan, max_points);
@@ -160,7 +189,6 @@ int runReader(const Args& a) {
       if (until_closed && got == ReadStatus::kTimeout && status == WriterStatus::kClosed) break;
     }
   }
-  const ReaderStats& s = reader.stats();
   std::string epoch_list;
   for (std::uint64_t e : epochs) {
     if (!epoch_list.empty()) epoch_list += ',';

@@ -137,7 +137,7 @@ TEST(RingProtocol, SlotLeftOddByADeadWriterIsNeverReturned) {
   // Writer "dies" while writing scan 4 into slot 0 (which held scan 0).
   test::fillPattern(in, 99, 100);
   const std::uint64_t index = beginPublish(view);
-  writePayload(view, index, in, 1, 0);
+  writePayload(view, index, in, 1);
   std::uint64_t next = 0;
   Scan out;
   ReadCounters counters;
@@ -192,11 +192,13 @@ TEST(RingProtocol, ConcurrentWriterAndReaderNeverYieldATornScan) {
               static_cast<unsigned long long>(counters.torn_reads));
 }
 
-// A writer that republishes two ready-made scans back to back into a 2-slot ring laps a reader that copies
-// at the same speed, so the reader's copies do get torn. Each must be detected and dropped — never returned
-// (a mix of the two scans would fail checkPattern). Runs until it has seen 3 torn copies, at most 5 s.
+// A writer republishes two ready-made 1 M-point scans (23 MB, milliseconds to copy) back to back into a
+// 2-slot ring, so the reader's copies do get torn: by the writer running on the other core, or — on a loaded
+// machine where the two threads take turns — by the writer running while the reader is preempted mid-copy.
+// Each torn copy must be detected and dropped, never returned (a mix of the two would fail checkPattern).
+// Runs until it has seen 3 torn copies, at most 5 s.
 TEST(RingProtocol, TornCopiesAreDetectedAndDiscarded) {
-  constexpr std::uint32_t kMax = 100'000;
+  constexpr std::uint32_t kMax = 1'000'000;
   RingView view;
   auto ring = makeRing(2, kMax, view);
   Scan a, b;

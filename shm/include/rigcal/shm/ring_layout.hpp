@@ -76,7 +76,7 @@ struct alignas(kCacheLine) SlotHeader {
   std::atomic<std::uint64_t> seq;
   std::atomic<std::uint64_t> sensor_sequence;
   std::atomic<std::int64_t> stamp_ns;
-  std::atomic<std::int64_t> publish_ns;  // CLOCK_MONOTONIC when publish() began
+  std::atomic<std::int64_t> publish_ns;  // CLOCK_MONOTONIC when the payload was complete (before seq even)
   std::atomic<std::uint64_t> checksum;   // over the header fields below and the point arrays
   std::atomic<std::uint64_t> epoch;      // of the writer that wrote the slot
   std::atomic<std::uint32_t> point_count;

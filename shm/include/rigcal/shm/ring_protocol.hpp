@@ -23,7 +23,7 @@ namespace rigcal::shm {
 struct ScanMeta {
   std::uint64_t ring_index = 0;  // position in the ring's publication order (continues across writers)
   std::uint64_t epoch = 0;       // epoch of the writer that published it
-  std::int64_t publish_ns = 0;   // CLOCK_MONOTONIC when its publish began
+  std::int64_t publish_ns = 0;   // CLOCK_MONOTONIC when it was complete in its slot, just before it became visible
 };
 
 /// A mapped ring: header and slots, wherever this process mapped them.
@@ -70,8 +70,7 @@ std::uint64_t publishScan(const RingView& ring, const Scan& scan, std::uint64_t 
 
 /// The steps of publishScan, exposed so a test can stop between them (a writer dying mid-write).
 std::uint64_t beginPublish(const RingView& ring);  // seq odd; returns the index being written
-void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch,
-                  std::int64_t publish_ns);
+void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch);
 void commitPublish(const RingView& ring, std::uint64_t index, const Scan& scan);  // seq even, index+1, wake
 
 /// Bumps the futex word and wakes every sleeping reader (after a publish, on close, after a takeover).
