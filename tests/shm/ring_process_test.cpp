@@ -42,21 +42,21 @@ std::string summaryOf(Subprocess& reader, std::chrono::milliseconds timeout = 9s
 
 TEST(RingProcesses, WriterAndThreeReadersExchangeScansIntact) {
   test::UniquePrefix prefix;
-  auto writer = peer("writer", prefix, {"--points", "20000", "--slots", "8", "--count", "100", "--rate", "100",
+  auto writer = peer("writer", prefix, {"--points", "10000", "--slots", "8", "--count", "60", "--rate", "100",
                                         "--wait-readers", "3"});
   ASSERT_TRUE(writer->waitForLine("ready", 5s)) << writer->errText();
   std::vector<std::unique_ptr<Subprocess>> readers;
   for (int i = 0; i < 3; ++i) {
-    readers.push_back(peer("reader", prefix, {"--points", "20000", "--count", "100", "--oldest"}));
+    readers.push_back(peer("reader", prefix, {"--points", "10000", "--count", "60", "--oldest"}));
   }
   for (auto& r : readers) {
     const std::string s = summaryOf(*r);
-    EXPECT_EQ(intField(s, "good"), 100) << s;
+    EXPECT_EQ(intField(s, "good"), 60) << s;
     EXPECT_EQ(intField(s, "bad"), 0) << s;
     EXPECT_EQ(intField(s, "overruns"), 0) << s;
     EXPECT_EQ(intField(s, "checksum_errors"), 0) << s;
     EXPECT_EQ(intField(s, "first_seq"), 0) << s;
-    EXPECT_EQ(intField(s, "last_seq"), 99) << s;
+    EXPECT_EQ(intField(s, "last_seq"), 59) << s;
   }
   ASSERT_EQ(writer->wait(5s), 0) << writer->errText();
   EXPECT_TRUE(prefix.segments().empty()) << "segment left behind after a clean shutdown";
@@ -124,12 +124,12 @@ TEST(RingProcesses, WriterKilledAtRandomMomentsNeverYieldsATornScan) {
 
 TEST(RingProcesses, KilledReadersDoNotAffectTheWriter) {
   test::UniquePrefix prefix;
-  auto writer = peer("writer", prefix, {"--points", "20000", "--slots", "8", "--count", "150", "--rate", "100",
+  auto writer = peer("writer", prefix, {"--points", "5000", "--slots", "8", "--count", "150", "--rate", "100",
                                         "--start-delay-ms", "300"});
   ASSERT_TRUE(writer->waitForLine("ready", 5s));
-  auto steady = peer("reader", prefix, {"--points", "20000", "--count", "150", "--oldest"});
-  auto victim1 = peer("reader", prefix, {"--points", "20000", "--oldest"});
-  auto victim2 = peer("reader", prefix, {"--points", "20000", "--oldest"});
+  auto steady = peer("reader", prefix, {"--points", "5000", "--count", "150", "--oldest"});
+  auto victim1 = peer("reader", prefix, {"--points", "5000", "--oldest"});
+  auto victim2 = peer("reader", prefix, {"--points", "5000", "--oldest"});
   std::this_thread::sleep_for(500ms);
   victim1->kill(SIGKILL);  // most likely asleep in FUTEX_WAIT
   std::this_thread::sleep_for(300ms);
@@ -139,7 +139,8 @@ TEST(RingProcesses, KilledReadersDoNotAffectTheWriter) {
   const auto published = writer->waitForLine("published", 6s);
   ASSERT_TRUE(published) << writer->errText();
   EXPECT_EQ(intField(*published, "n"), 150);
-  // 150 scans at 100 Hz take 1.49 s; a writer that waited for its dead readers would never finish.
+  // 150 scans at 100 Hz take 1.49 s; a writer that waited for its dead readers would never finish. (The
+  // margin is for sanitizer builds on a loaded 2-core machine, where generating a scan takes milliseconds.)
   EXPECT_LT(intField(*published, "elapsed_ms"), 3000) << *published;
   EXPECT_EQ(writer->wait(3s), 0);
   const std::string s = summaryOf(*steady);
