@@ -9,7 +9,9 @@
 //     reader keeps up (it only pauses when it would overwrite an unread slot), against memcpy of the same
 //     bytes into ring-sized rotating buffers in the same run.
 //
-// Usage: shm_ring_bench [--latency-scans N] [--period-us P] [--throughput-scans N]
+// Usage: shm_ring_bench [--latency-scans N] [--period-us P] [--throughput-scans N] [--fifo PRIO]
+//   --fifo PRIO runs writer, reader and the memcpy baseline under SCHED_FIFO (needs CAP_SYS_NICE): on a
+//   machine busy with other work it measures the ring rather than the queue for the CPU.
 #include <sched.h>
 #include <unistd.h>
 
@@ -40,11 +42,16 @@ long long num(const Args& a, const std::string& k, long long dflt) {
   return it == a.end() ? dflt : std::strtoll(it->second.c_str(), nullptr, 10);
 }
 
-void pin(int cpu) {
+void pin(int cpu, int fifo_priority) {
   cpu_set_t set;
   CPU_ZERO(&set);
   CPU_SET(cpu, &set);
   if (::sched_setaffinity(0, sizeof set, &set) != 0) std::perror("sched_setaffinity");
+  if (fifo_priority > 0) {
+    sched_param p{};
+    p.sched_priority = fifo_priority;
+    if (::sched_setscheduler(0, SCHED_FIFO, &p) != 0) std::perror("sched_setscheduler(SCHED_FIFO)");
+  }
 }
 
 void sleepUntil(std::int64_t mono_ns) {
@@ -90,7 +97,7 @@ long long readerNext(const ScanRingWriter& w) {
 }
 
 int runWriter(const Args& a) {
-  pin(static_cast<int>(num(a, "cpu", 0)));
+  pin(static_cast<int>(num(a, "cpu", 0)), static_cast<int>(num(a, "fifo", 0)));
   const auto points = static_cast<std::uint32_t>(num(a, "points", 1000));
   const long long scans = num(a, "scans", 1000);
   const long long period_ns = num(a, "period-us", 0) * 1000;
@@ -128,7 +135,7 @@ int runWriter(const Args& a) {
 }
 
 int runReader(const Args& a) {
-  pin(static_cast<int>(num(a, "cpu", 1)));
+  pin(static_cast<int>(num(a, "cpu", 1)), static_cast<int>(num(a, "fifo", 0)));
   const long long scans = num(a, "scans", 1000);
   ReaderOptions o;
   o.sensor = "bench";
@@ -143,9 +150,13 @@ int runReader(const Args& a) {
   e2e.reserve(static_cast<std::size_t>(scans));
   std::int64_t last = 0;
   long long got = 0;
-  const std::int64_t deadline = monotonicNs() + 120'000'000'000;
-  while (got < scans && monotonicNs() < deadline) {
-    if (reader.read(scan, std::chrono::seconds(1), &meta) != ReadStatus::kScan) continue;
+  const std::int64_t deadline = monotonicNs() + 60'000'000'000;
+  const ReaderStats& s = reader.stats();
+  while (got + static_cast<long long>(s.overruns) < scans && monotonicNs() < deadline) {
+    if (reader.read(scan, std::chrono::milliseconds(200), &meta) != ReadStatus::kScan) {
+      if (reader.writerStatus() == WriterStatus::kClosed) break;
+      continue;
+    }
     last = monotonicNs();
     if (++got > 10) {  // the first few pay for page faults and cold caches
       hop.push_back(last - meta.publish_ns);
@@ -161,8 +172,9 @@ int runReader(const Args& a) {
 
 /// Runs a writer and a reader process with `args`; returns their report lines.
 std::pair<std::string, std::string> runPair(const std::string& self, const std::string& args, int writer_cpu,
-                                            int reader_cpu) {
-  const std::string common = " --prefix rigcal-bench-" + std::to_string(::getpid()) + ". " + args;
+                                            int reader_cpu, int fifo) {
+  const std::string common =
+      " --prefix rigcal-bench-" + std::to_string(::getpid()) + ". --fifo " + std::to_string(fifo) + " " + args;
   FILE* r = ::popen((self + " --role reader --cpu " + std::to_string(reader_cpu) + common).c_str(), "r");
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   FILE* w = ::popen((self + " --role writer --cpu " + std::to_string(writer_cpu) + common).c_str(), "r");
@@ -202,19 +214,21 @@ int runParent(const std::string& self, const Args& a) {
   const long long lat_scans = num(a, "latency-scans", 2000);
   const long long period_us = num(a, "period-us", 2000);
   const long long tput_scans = num(a, "throughput-scans", 300);
+  const int fifo = static_cast<int>(num(a, "fifo", 0));
   char load[64] = "?";
   if (FILE* f = std::fopen("/proc/loadavg", "r")) {
     if (!std::fgets(load, sizeof load, f)) load[0] = '\0';
     std::fclose(f);
   }
-  std::printf("shm_ring_bench  cpus=%ld  loadavg %s", ::sysconf(_SC_NPROCESSORS_ONLN), load);
+  std::printf("shm_ring_bench  cpus=%ld  scheduling %s  loadavg %s", ::sysconf(_SC_NPROCESSORS_ONLN),
+              fifo > 0 ? ("SCHED_FIFO " + std::to_string(fifo)).c_str() : "SCHED_OTHER", load);
   std::printf("latency, blocking futex wake-up, %lld scans, one every %lld us (microseconds)\n", lat_scans, period_us);
   std::printf("  %-8s %-9s %-7s %s\n", "points", "payload", "cores", "result");
   for (std::uint32_t points : {1'000u, 65'536u, 240'000u}) {
     for (const auto& [wc, rc] : {std::pair{0, 1}, std::pair{0, 0}}) {
       const std::string args = "--mode latency --points " + std::to_string(points) + " --scans " +
                                std::to_string(lat_scans) + " --period-us " + std::to_string(period_us);
-      const auto [wline, rline] = runPair(self, args, wc, rc);
+      const auto [wline, rline] = runPair(self, args, wc, rc, fifo);
       char payload[32];
       std::snprintf(payload, sizeof payload, "%.2f MB", static_cast<double>(payloadBytes(points)) / 1e6);
       std::printf("  %-8u %-9s %d -> %d   %s", points, payload, wc, rc, rline.c_str());
@@ -222,11 +236,12 @@ int runParent(const std::string& self, const Args& a) {
   }
   constexpr std::uint32_t kVls128 = 240'000;
   const double bytes = static_cast<double>(payloadBytes(kVls128));
+  pin(0, fifo);  // the baseline runs where the writer runs
   const double memcpy_mbps = memcpyMBps(kVls128, 40);
   const auto [wline, rline] = runPair(self,
                                       "--mode throughput --lockstep 1 --points " + std::to_string(kVls128) +
                                           " --scans " + std::to_string(tput_scans),
-                                      0, 1);
+                                      0, 1, fifo);
   const long long t0 = std::strtoll(wline.substr(wline.find("t0=") + 3).c_str(), nullptr, 10);
   const long long in_publish = std::strtoll(wline.substr(wline.find("in_publish_ns=") + 14).c_str(), nullptr, 10);
   const long long last = std::strtoll(rline.substr(rline.find("last=") + 5).c_str(), nullptr, 10);

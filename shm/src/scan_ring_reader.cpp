@@ -54,7 +54,7 @@ struct ScanRingReader::Impl {
 bool ScanRingReader::Impl::tryAttach(bool use_start_option) {
   std::optional<detail::Segment> seg = detail::Segment::open(name, true);
   if (!seg || seg->size() < sizeof(RingHeader)) return false;  // none yet, or its writer is creating it
-  seg->map();
+  seg->map(true);
   if (checkHeader(seg->base(), seg->mappedBytes(), name) == HeaderState::kUninitialised) return false;
   segment = std::move(*seg);
   view = RingView(segment.base(), segment.mappedBytes());

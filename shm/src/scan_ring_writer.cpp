@@ -1,5 +1,6 @@
 #include "rigcal/shm/scan_ring_writer.hpp"
 
+#include <cstring>
 #include <stdexcept>
 
 #include "rigcal/shm/liveness.hpp"
@@ -71,7 +72,8 @@ void ScanRingWriter::Impl::openSegment() {
     if (!seg->isStillNamed()) continue;  // another writer replaced it while we were locking
     if (created || seg->size() == 0) {
       seg->truncate(bytes);
-      seg->map();
+      seg->map(true);
+      std::memset(seg->base(), 0, bytes);  // allocates every page now rather than during the first lap
       initRing(seg->base(), options.sensor, options.slot_count, options.max_points, fresh_epoch);
       segment = std::move(*seg);
       view = RingView(segment.base(), segment.mappedBytes());
@@ -79,7 +81,7 @@ void ScanRingWriter::Impl::openSegment() {
       return;
     }
     // A segment nobody writes: left behind by a dead writer. Take it over.
-    seg->map();
+    seg->map(true);
     HeaderState state = HeaderState::kUninitialised;
     try {
       state = checkHeader(seg->base(), seg->mappedBytes(), name);

@@ -1,6 +1,7 @@
 #include "segment.hpp"
 
 #include <sys/file.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 
 #include <cerrno>
@@ -65,9 +66,10 @@ void Segment::truncate(std::uint64_t bytes) {
   }
 }
 
-void Segment::map() {
+void Segment::map(bool populate) {
   try {
-    region_ = bip::mapped_region(shm_, writable_ ? bip::read_write : bip::read_only);
+    region_ = bip::mapped_region(shm_, writable_ ? bip::read_write : bip::read_only, 0, 0, nullptr,
+                                 populate ? MAP_POPULATE : bip::default_map_options);
   } catch (const bip::interprocess_exception& e) {
     fail("cannot map", name_, e.what());
   }

@@ -27,7 +27,9 @@ class Segment {
   [[nodiscard]] int fd() const;
   [[nodiscard]] std::uint64_t size() const;
   void truncate(std::uint64_t bytes);
-  void map();  // all of it, read-write or read-only as opened
+  /// Maps all of it, read-write or read-only as opened. `populate` pre-faults every page (MAP_POPULATE) so
+  /// the first lap of the ring does not pay a page fault per 4 KiB.
+  void map(bool populate = false);
   [[nodiscard]] void* base() const { return region_.get_address(); }
   [[nodiscard]] std::size_t mappedBytes() const { return region_.get_size(); }
   /// flock(LOCK_EX | LOCK_NB): true if this process now holds the writer lock. The kernel drops it when

@@ -198,7 +198,11 @@ TEST(RingProtocol, ConcurrentWriterAndReaderNeverYieldATornScan) {
 // Each torn copy must be detected and dropped, never returned (a mix of the two would fail checkPattern).
 // Runs until it has seen 3 torn copies, at most 5 s.
 TEST(RingProtocol, TornCopiesAreDetectedAndDiscarded) {
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+  constexpr std::uint32_t kMax = 200'000;  // instrumented copies are 10-50x slower: as long, fewer points
+#else
   constexpr std::uint32_t kMax = 1'000'000;
+#endif
   RingView view;
   auto ring = makeRing(2, kMax, view);
   Scan a, b;
@@ -212,7 +216,7 @@ TEST(RingProtocol, TornCopiesAreDetectedAndDiscarded) {
   ReadCounters counters;
   Scan out;
   const std::int64_t give_up = monotonicNs() + 5'000'000'000;
-  while ((counters.torn_reads < 3 || got < 3) && monotonicNs() < give_up) {
+  while ((counters.torn_reads < 3 || got < 1) && monotonicNs() < give_up) {
     if (readNext(view, next, out, nullptr, counters) != ReadOutcome::kScan) continue;
     ++got;
     if (!test::checkPattern(out, kMax).empty()) ++bad;
