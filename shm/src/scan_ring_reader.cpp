@@ -38,6 +38,7 @@ struct ScanRingReader::Impl {
   std::uint64_t epoch = 0;
   int record = -1;
   WriterStatus status = WriterStatus::kAbsent;
+  bool gone_reported = false;  // kWriterGone already returned for the current writer
   std::int64_t next_liveness_ns = 0;
   ReadCounters counters;
   ReaderStats stats;
@@ -48,7 +49,7 @@ struct ScanRingReader::Impl {
   void releaseRecord();
   void publishRecord();
   void syncCounters();
-  void checkLiveness();
+  bool checkLiveness();
 };
 
 bool ScanRingReader::Impl::tryAttach(bool use_start_option) {
@@ -70,6 +71,7 @@ bool ScanRingReader::Impl::tryAttach(bool use_start_option) {
   const bool from_next = use_start_option && options.start_at == ReaderOptions::StartAt::kNext;
   next_index = from_next ? written : written - std::min<std::uint64_t>(written, view.slotCount());
   status = evaluateWriter(h, options.stall_after);
+  gone_reported = false;
   next_liveness_ns = monotonicNs() + options.liveness_period.count() * 1'000'000;
   claimRecord();
   return true;
@@ -124,18 +126,27 @@ void ScanRingReader::Impl::syncCounters() {
   stats.checksum_errors = counters.checksum_errors;
 }
 
-void ScanRingReader::Impl::checkLiveness() {
+/// Re-evaluates the writer. True when it has just been found gone (closed or dead) with everything it
+/// published already read: the moment read() reports kWriterGone.
+bool ScanRingReader::Impl::checkLiveness() {
   const RingHeader& h = view.header();
   status = evaluateWriter(h, options.stall_after);
   if (record >= 0) view.header().readers[record].active_ns.store(monotonicNs(), kRelaxed);
-  if (status != WriterStatus::kDead && status != WriterStatus::kClosed) return;
-  // No writer here. Once we have read everything it left, see whether a new writer made a new segment
-  // under our name (a clean shutdown unlinks; a takeover with another geometry recreates).
-  if (next_index < h.write_index.load(kAcquire) || segment.isStillNamed()) return;
+  if (status != WriterStatus::kDead && status != WriterStatus::kClosed) {
+    gone_reported = false;
+    return false;
+  }
+  if (next_index < h.write_index.load(kAcquire)) return false;  // its scans first
+  const bool report = !gone_reported;
+  gone_reported = true;
+  // See whether a new writer made a new segment under our name (a clean shutdown unlinks; a takeover with
+  // another geometry recreates).
+  if (segment.isStillNamed()) return report;
   const WriterStatus last = status;
   detach();
   status = last;
-  tryAttach(false);
+  if (tryAttach(false)) return false;  // already following the new writer
+  return report;
 }
 
 ScanRingReader::ScanRingReader(const ReaderOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -175,6 +186,7 @@ ReadStatus ScanRingReader::read(Scan& out, std::chrono::nanoseconds timeout, Sca
       ++m.stats.writer_restarts;
       m.epoch = e;
       m.status = evaluateWriter(h, m.options.stall_after);
+      m.gone_reported = false;
     }
     if (readNext(m.view, m.next_index, out, meta, m.counters) == ReadOutcome::kScan) {
       if (out.sensor_id != m.options.sensor) out.sensor_id = m.options.sensor;
@@ -189,8 +201,9 @@ ReadStatus ScanRingReader::read(Scan& out, std::chrono::nanoseconds timeout, Sca
     m.publishRecord();
     std::int64_t now = monotonicNs();
     if (now >= m.next_liveness_ns) {
-      m.checkLiveness();
+      const bool gone = m.checkLiveness();
       m.next_liveness_ns = now + period;
+      if (gone) return ReadStatus::kWriterGone;
       if (!m.attached || &h != &m.view.header()) continue;  // detached or re-attached: start over
     }
     if (now >= deadline) return ReadStatus::kTimeout;
@@ -200,6 +213,11 @@ ReadStatus ScanRingReader::read(Scan& out, std::chrono::nanoseconds timeout, Sca
     const bool ready = h.write_index.load(kSeqCst) > m.next_index || h.epoch.load(kSeqCst) != m.epoch;
     if (!ready) futexWait(h.futex_word, seen, std::chrono::nanoseconds(std::min(deadline, m.next_liveness_ns) - now));
     h.waiters.fetch_sub(1, kSeqCst);
+    // A clean close also bumps the futex word: look at the writer now rather than at the next period.
+    if (m.status != WriterStatus::kClosed &&
+        h.writer_state.load(kAcquire) == static_cast<std::uint32_t>(WriterState::kClosed)) {
+      m.next_liveness_ns = monotonicNs();
+    }
   }
 }
 

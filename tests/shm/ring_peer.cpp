@@ -178,7 +178,7 @@ int runReader(const Args& a) {
       if (delay_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
     }
     const std::int64_t now = monotonicNs();
-    if (got == ReadStatus::kTimeout || now >= next_status_check) {
+    if (got != ReadStatus::kScan || now >= next_status_check) {
       next_status_check = now + 20'000'000;
       const WriterStatus status = reader.writerStatus();
       dead_seen = dead_seen || status == WriterStatus::kDead;
@@ -186,7 +186,7 @@ int runReader(const Args& a) {
           std::string("status=") + toString(status) + " epoch=" + std::to_string(reader.epoch());
       if (report != last_report) say(report);
       last_report = report;
-      if (until_closed && got == ReadStatus::kTimeout && status == WriterStatus::kClosed) break;
+      if (until_closed && got != ReadStatus::kScan && status == WriterStatus::kClosed) break;
     }
   }
   std::string epoch_list;

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <thread>
 
 #include "rigcal/shm/ring_error.hpp"
 #include "rigcal/shm/ring_inspect.hpp"
@@ -87,6 +88,57 @@ TEST(ScanRing, ExchangesScansAndUnlinksOnCleanShutdown) {
   EXPECT_TRUE(prefix.segments().empty()) << "segment left behind after a clean shutdown";
   EXPECT_EQ(reader.writerStatus(), WriterStatus::kClosed);
   EXPECT_EQ(reader.stats().scans, 3u);
+}
+
+TEST(ScanRing, ReaderOfARunningRingStartsWithTheNextScanByDefault) {
+  test::UniquePrefix prefix;
+  ScanRingWriter writer(writerOptions(prefix));
+  Scan in, out;
+  for (std::uint64_t s = 0; s < 3; ++s) {
+    test::fillPattern(in, s, test::patternPoints(s, 1000));
+    writer.publish(in);
+  }
+  ReaderOptions options = readerOptions(prefix);
+  options.start_at = ReaderOptions::StartAt::kNext;
+  ScanRingReader reader(options);
+  EXPECT_FALSE(reader.tryRead(out));
+  test::fillPattern(in, 3, test::patternPoints(3, 1000));
+  writer.publish(in);
+  ASSERT_TRUE(reader.tryRead(out));
+  EXPECT_EQ(out.sequence, 3u);
+  EXPECT_EQ(reader.stats().overruns, 0u);
+}
+
+TEST(ScanRing, QuietWriterIsStalledUntilItsNextHeartbeat) {
+  test::UniquePrefix prefix;
+  ScanRingWriter writer(writerOptions(prefix));
+  ReaderOptions options = readerOptions(prefix);
+  options.stall_after = 50ms;
+  ScanRingReader reader(options);
+  EXPECT_EQ(reader.writerStatus(), WriterStatus::kAlive);
+  std::this_thread::sleep_for(80ms);
+  EXPECT_EQ(reader.writerStatus(), WriterStatus::kStalled);
+  writer.heartbeat();
+  EXPECT_EQ(reader.writerStatus(), WriterStatus::kAlive);
+}
+
+TEST(ScanRing, ReaderNoticesACleanCloseWithoutWaitingForItsLivenessPeriod) {
+  test::UniquePrefix prefix;
+  auto writer = std::make_unique<ScanRingWriter>(writerOptions(prefix));
+  ReaderOptions options = readerOptions(prefix);
+  options.liveness_period = 10s;
+  ScanRingReader reader(options);
+  std::thread closer([&] {
+    std::this_thread::sleep_for(50ms);
+    writer.reset();
+  });
+  Scan out;
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(reader.read(out, 5s), ReadStatus::kWriterGone);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 2s);
+  closer.join();
+  EXPECT_EQ(reader.writerStatus(), WriterStatus::kClosed);
+  EXPECT_EQ(reader.read(out, 50ms), ReadStatus::kTimeout);  // reported once; then it waits for a new writer
 }
 
 TEST(ScanRing, OversizeScanIsDroppedAndCountedNotTruncated) {

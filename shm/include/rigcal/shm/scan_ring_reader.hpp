@@ -30,7 +30,12 @@ struct ReaderOptions {
   bool publish_stats = true;  // take a reader record in the header so `rigcal monitor` shows our counters
 };
 
-enum class ReadStatus { kScan, kTimeout };
+enum class ReadStatus {
+  kScan,        // `out` holds the next scan
+  kTimeout,     // nothing new within the timeout
+  kWriterGone,  // the writer closed or died and every scan it published has been read; returned once per
+                // writer, as soon as a liveness check sees it. Keep calling read(): a new writer is followed.
+};
 
 class ScanRingReader {
  public:
@@ -40,7 +45,7 @@ class ScanRingReader {
   ScanRingReader(ScanRingReader&&) noexcept;
   ScanRingReader& operator=(ScanRingReader&&) noexcept;
 
-  /// The next scan, waiting at most `timeout` for one. `out` is unspecified after kTimeout.
+  /// The next scan, waiting at most `timeout` for one. `out` is unspecified unless kScan.
   /// Throws RingError if a ring that appears meanwhile has another layout or a corrupted header.
   ReadStatus read(Scan& out, std::chrono::nanoseconds timeout, ScanMeta* meta = nullptr);
   /// read() without waiting.
