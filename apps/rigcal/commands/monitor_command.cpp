@@ -54,15 +54,10 @@ std::vector<std::string> ringNames(const std::vector<std::string>& sensors, cons
 
 void printTable(const std::vector<std::string>& names, const std::map<std::string, shm::RingInfo>& before,
                 const std::map<std::string, shm::RingInfo>& now, const std::string& prefix) {
-  std::size_t width = 6;
-  for (const auto& n : names) width = std::max(width, n.size() + 2);
-  const int ring_w = static_cast<int>(width);
-  std::ostringstream out;
-  out << std::left << std::setw(ring_w) << "RING" << std::setw(9) << "WRITER" << std::setw(9) << "PID"
-      << std::setw(6) << "EPOCH" << std::right << std::setw(9) << "SCANS/S" << std::setw(10) << "POINTS/S"
-      << std::setw(22) << "LAST STAMP (s)" << std::setw(10) << "LAG (s)" << std::setw(9) << "AGE (ms)"
-      << std::setw(8) << "READERS" << std::setw(10) << "OVERRUNS" << std::setw(7) << "TORN" << std::setw(8)
-      << "BACKLOG" << '\n';
+  // Cells first, then widths: columns fit their widest cell (a pcap replay's lag can have nine digits).
+  std::vector<std::vector<std::string>> rows = {{"RING", "WRITER", "PID", "EPOCH", "SCANS/S", "POINTS/S",
+                                                 "LAST STAMP (s)", "LAG (s)", "AGE (ms)", "READERS",
+                                                 "OVERRUNS", "TORN", "BACKLOG"}};
   std::vector<std::string> errors;
   const std::int64_t now_real = shm::realtimeNs();
   for (const auto& name : names) {
@@ -81,15 +76,27 @@ void printTable(const std::vector<std::string>& names, const std::map<std::strin
       points_s = human(static_cast<double>(r.total_points - prev->second.total_points) / dt);
     }
     const bool any = r.write_index > 0;
-    out << std::left << std::setw(ring_w) << name << std::setw(9) << status << std::setw(9)
-        << (r.writer_pid > 0 ? std::to_string(r.writer_pid) : "-") << std::setw(6)
-        << (r.epoch > 0 ? std::to_string(r.epoch) : "-") << std::right << std::setw(9) << scans_s
-        << std::setw(10) << points_s << std::setw(22)
-        << (any ? fixed(static_cast<double>(r.last_stamp_ns) * 1e-9, 3) : "-") << std::setw(10)
-        << (any ? fixed(static_cast<double>(now_real - r.last_stamp_ns) * 1e-9, 3) : "-") << std::setw(9)
-        << (any ? std::to_string((r.sampled_ns - r.last_publish_ns) / 1'000'000) : "-") << std::setw(8)
-        << r.readers << std::setw(10) << r.overruns << std::setw(7) << r.torn_reads << std::setw(8)
-        << r.max_backlog << '\n';
+    const bool readable = r.present && r.error.empty() && r.epoch > 0;
+    rows.push_back({name, status, r.writer_pid > 0 ? std::to_string(r.writer_pid) : "-",
+                    r.epoch > 0 ? std::to_string(r.epoch) : "-", scans_s, points_s,
+                    any ? fixed(static_cast<double>(r.last_stamp_ns) * 1e-9, 3) : "-",
+                    any ? fixed(static_cast<double>(now_real - r.last_stamp_ns) * 1e-9, 3) : "-",
+                    any ? std::to_string((r.sampled_ns - r.last_publish_ns) / 1'000'000) : "-",
+                    readable ? std::to_string(r.readers) : "-", readable ? std::to_string(r.overruns) : "-",
+                    readable ? std::to_string(r.torn_reads) : "-", readable ? std::to_string(r.max_backlog) : "-"});
+  }
+  std::vector<std::size_t> width(rows[0].size(), 0);
+  for (const auto& row : rows) {
+    for (std::size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], row[c].size());
+  }
+  std::ostringstream out;
+  for (const auto& row : rows) {
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      if (c > 0) out << "  ";
+      // Names and states left-aligned, numbers right-aligned.
+      out << (c < 2 ? std::left : std::right) << std::setw(static_cast<int>(width[c])) << row[c];
+    }
+    out << '\n';
   }
   if (names.empty()) out << "(no rings under " << shm::segmentPath(prefix).string() << "*)\n";
   for (const auto& e : errors) out << "error: " << e << '\n';
