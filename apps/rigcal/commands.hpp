@@ -17,5 +17,6 @@ struct CommandFailed : std::runtime_error {
 void addCheckConfigCommand(CLI::App& app);
 void addDecodeCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
+void addMonitorCommand(CLI::App& app);
 
 }  // namespace rigcal::app

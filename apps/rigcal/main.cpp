@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   addCheckConfigCommand(app);
   addDecodeCommand(app);
   addReplayCommand(app);
+  addMonitorCommand(app);
 
   try {
     app.parse(argc, argv);

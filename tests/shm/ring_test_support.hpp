@@ -1,0 +1,35 @@
+#pragma once
+// What the ring tests share: a segment-name prefix no other test (or test run) uses, removed with every
+// segment under it when the test ends; the peer executable; the allocation counter.
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rigcal::shm::test {
+
+/// "rigcal-test-<pid>-<n>." — unique per test; the destructor removes any segment left under it.
+class UniquePrefix {
+ public:
+  UniquePrefix();
+  ~UniquePrefix();
+  UniquePrefix(const UniquePrefix&) = delete;
+  UniquePrefix& operator=(const UniquePrefix&) = delete;
+  [[nodiscard]] const std::string& str() const { return prefix_; }
+  /// Segments currently under the prefix.
+  [[nodiscard]] std::vector<std::string> segments() const;
+
+ private:
+  std::string prefix_;
+};
+
+/// The ring_peer executable built next to the tests.
+std::string peerPath();
+
+/// Counts operator new calls made while counting is enabled (defined in alloc_counter.cpp).
+struct AllocationCounter {
+  static void start();
+  static std::uint64_t stop();  // allocations since start()
+};
+
+}  // namespace rigcal::shm::test
