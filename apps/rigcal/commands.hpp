@@ -16,6 +16,7 @@ struct CommandFailed : std::runtime_error {
 
 void addCheckConfigCommand(CLI::App& app);
 void addDecodeCommand(CLI::App& app);
+void addDriverCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
 void addMonitorCommand(CLI::App& app);
 

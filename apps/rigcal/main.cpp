@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
 
   addCheckConfigCommand(app);
   addDecodeCommand(app);
+  addDriverCommand(app);
   addReplayCommand(app);
   addMonitorCommand(app);
 

@@ -12,38 +12,10 @@
 #include <ctime>
 #include <stdexcept>
 
+#include "rigcal/drivers/pacing.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
 
 namespace rigcal::drivers {
-
-namespace {
-
-TimeNs monotonicNow() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return TimeNs(ts.tv_sec) * kNsPerSec + ts.tv_nsec;
-}
-
-constexpr TimeNs kStopCheckNs = 10 * kNsPerMs;
-
-// Sleeps until the absolute monotonic time `deadline` (no drift from summed relative sleeps), waking
-// every 10 ms to see whether stop() was called. Returns false when stopped.
-bool sleepUntil(TimeNs deadline, const std::atomic<bool>& stop) {
-  while (!stop.load(std::memory_order_relaxed)) {
-    const TimeNs now = monotonicNow();
-    if (now >= deadline) return true;
-    const TimeNs wake = std::min(deadline, now + kStopCheckNs);
-    timespec ts{};
-    ts.tv_sec = time_t(wake / kNsPerSec);
-    ts.tv_nsec = long(wake % kNsPerSec);
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-      if (stop.load(std::memory_order_relaxed)) return false;
-    }
-  }
-  return false;
-}
-
-}  // namespace
 
 PcapReplayer::PcapReplayer(std::filesystem::path capture, ReplayConfig config)
     : capture_(std::move(capture)), config_(config) {

@@ -1,0 +1,101 @@
+// `rigcal driver --config RIG --sensor NAME (--live | --pcap F [--rate R])`: one sensor's driver in its
+// own process, writing every finished scan into the shared-memory ring /rigcal.<sensor>.
+#include <iostream>
+
+#include "../commands.hpp"
+#include "../exit_codes.hpp"
+#include "../stop_signals.hpp"
+#include "rigcal/config/rig_config.hpp"
+#include "rigcal/pipeline/sensor_driver.hpp"
+#include "rigcal/shm/ring_error.hpp"
+#include "rigcal/shm/scan_ring_writer.hpp"
+
+namespace rigcal::app {
+
+namespace {
+
+struct DriverOptions {
+  std::string config, sensor, pcap, rate = "1.0", shm_prefix;
+  bool live = false;
+  unsigned slots = 8;
+};
+
+double parseRate(const std::string& text) {
+  if (text == "max") return 0.0;
+  try {
+    const double r = std::stod(text);
+    if (r > 0) return r;
+  } catch (const std::exception&) {
+  }
+  throw CommandFailed(kExitUsage, "--rate must be a positive number or 'max', got '" + text + "'");
+}
+
+void run(const DriverOptions& o) {
+  config::RigConfig rig;
+  config::SensorConfig sensor;
+  try {
+    rig = config::loadRigConfig(o.config);
+    sensor = rig.sensor(o.sensor);
+  } catch (const config::ConfigError& e) {
+    throw CommandFailed(kExitConfig, e.what());
+  }
+  pipeline::DriverInput input;
+  if (!o.live) {
+    input.pcap = o.pcap;
+    input.rate = parseRate(o.rate);
+  }
+
+  StopSignals signals;
+  std::unique_ptr<shm::ScanRingWriter> ring;
+  std::uint64_t published = 0, dropped = 0;
+  std::unique_ptr<pipeline::SensorDriver> driver;
+  try {
+    driver = std::make_unique<pipeline::SensorDriver>(sensor, input, StopSignals::flag(), [&](Scan&& scan) {
+      ring->publish(scan) ? ++published : ++dropped;
+    });
+    shm::WriterOptions w;
+    w.sensor = sensor.name;
+    w.max_points = std::uint32_t(driver->maxPointsPerScan());
+    w.slot_count = o.slots;
+    if (!o.shm_prefix.empty()) w.name_prefix = o.shm_prefix;
+    ring = std::make_unique<shm::ScanRingWriter>(w);
+  } catch (const shm::RingError& e) {
+    throw CommandFailed(kExitFailure, e.what());
+  } catch (const std::exception& e) {
+    throw CommandFailed(kExitInput, e.what());
+  }
+  std::cout << "driver '" << sensor.name << "' (" << sensor.model << ") writing " << ring->segmentName()
+            << (ring->tookOver() ? " (took over a stale ring)" : "") << std::endl;
+
+  driver->run([&] { ring->heartbeat(); });
+
+  const auto& a = driver->assemblerStats();
+  std::cout << "driver '" << sensor.name << "': " << published << " scans published, " << dropped
+            << " too large for a slot; " << a.packets << " packets, " << a.malformed << " malformed, "
+            << a.lost_packets << " lost" << std::endl;
+  if (!driver->warning().empty()) std::cerr << "warning: " << driver->warning() << '\n';
+  if (StopSignals::requested() && !o.live) throw CommandFailed(kExitInterrupted, "driver interrupted");
+}
+
+}  // namespace
+
+void addDriverCommand(CLI::App& app) {
+  auto o = std::make_shared<DriverOptions>();
+  auto* cmd = app.add_subcommand("driver", "Run one sensor's driver, writing scans into its shared-memory ring");
+  cmd->add_option("--config", o->config, "Rig YAML file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--sensor", o->sensor, "Sensor name in the rig file")->required();
+  auto* live = cmd->add_flag("--live", o->live, "Read the sensor's UDP port");
+  auto* pcap = cmd->add_option("--pcap", o->pcap, "Read a capture instead")->check(CLI::ExistingFile);
+  live->excludes(pcap);
+  cmd->add_option("--rate", o->rate, "With --pcap: 1.0 = recorded timing, 2 = twice as fast, max = no pacing")
+      ->needs(pcap);
+  cmd->add_option("--slots", o->slots, "Scans the ring keeps for slow readers")->check(CLI::Range(2u, 1024u));
+  cmd->add_option("--shm-prefix", o->shm_prefix, "Ring name prefix (default $RIGCAL_SHM_PREFIX or rigcal.)");
+  cmd->footer(std::string("Stops at the end of the capture, or on Ctrl-C (live). ") + kExitCodesHelp);
+  cmd->callback([o] {
+    if (!o->live && o->pcap.empty()) throw CommandFailed(kExitUsage, "driver needs --live or --pcap FILE");
+    run(*o);
+  });
+}
+
+}  // namespace rigcal::app

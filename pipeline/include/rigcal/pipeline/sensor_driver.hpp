@@ -1,0 +1,52 @@
+#pragma once
+// One sensor's driver as the rig file describes it: its packet source (live UDP, or a pcap filtered to
+// its port and address, optionally paced at the recorded rate), its decoder and its scan assembler.
+// `rigcal driver` runs one in its own process; the pipeline runs them as threads. Same code either way.
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "rigcal/config/rig_config.hpp"
+#include "rigcal/drivers/packet_decoder.hpp"
+#include "rigcal/drivers/packet_source.hpp"
+#include "rigcal/drivers/scan_assembler.hpp"
+
+namespace rigcal::pipeline {
+
+struct DriverInput {
+  std::optional<std::filesystem::path> pcap;  // empty: live UDP on the sensor's port
+  double rate = 0.0;                          // pcap only: 1.0 = recorded timing, 0 = as fast as possible
+};
+
+/// The decoder settings of a rig sensor.
+drivers::DecoderConfig decoderConfigFor(const config::SensorConfig& sensor);
+
+class SensorDriver {
+ public:
+  /// Throws std::runtime_error (one line, naming the sensor and what is wrong) when the source or the
+  /// decoder cannot be set up.
+  /// `stop` (outliving the driver) ends run() early, even inside a paced wait.
+  SensorDriver(const config::SensorConfig& sensor, const DriverInput& input, const std::atomic<bool>& stop,
+               drivers::ScanAssembler::ScanCallback on_scan);
+  ~SensorDriver();
+
+  /// Runs until the pcap ends or `stop` is set; calls `idle` whenever a live source timed out.
+  void run(const std::function<void()>& idle = {});
+  [[nodiscard]] std::size_t maxPointsPerScan() const { return decoder_->maxPointsPerScan(); }
+  [[nodiscard]] const drivers::AssemblerStats& assemblerStats() const { return assembler_.stats(); }
+  [[nodiscard]] const drivers::SourceStats& sourceStats() const { return source_->stats(); }
+  [[nodiscard]] std::string warning() const { return source_->warning(); }
+
+ private:
+  config::SensorConfig sensor_;
+  std::unique_ptr<drivers::PacketSource> raw_source_;
+  std::unique_ptr<drivers::PacketSource> source_;  // raw_source_, or a pacing wrapper around it
+  std::unique_ptr<drivers::PacketDecoder> decoder_;
+  drivers::ScanAssembler assembler_;
+  const std::atomic<bool>& stop_;
+  bool live_ = false;
+};
+
+}  // namespace rigcal::pipeline

@@ -1,0 +1,116 @@
+// `rigcal driver` as a real process writing a real shared-memory ring, read here as the pipeline would.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <thread>
+
+#include "rigcal/config/rig_config.hpp"
+#include "rigcal/pipeline/sensor_driver.hpp"
+#include "rigcal/shm/scan_ring_reader.hpp"
+#include "run_command.hpp"
+#include "test_data.hpp"
+
+namespace rigcal::test {
+namespace {
+
+class DriverCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    prefix_ = "rigcal-test-" + std::to_string(::getpid()) + "-" +
+              ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".";
+    rig_ = dir_ / "rig.yaml";
+    std::ofstream(rig_) << "sensors:\n  - name: roof\n    model: HDL-32E\n    source: {port: 2368}\n"
+                           "roles:\n  mapping_lidar: roof\n";
+  }
+  std::vector<std::string> driverArgs(const std::filesystem::path& pcap, const std::string& rate) {
+    return {"driver", "--config", rig_.string(), "--sensor", "roof", "--pcap", pcap.string(), "--rate", rate,
+            "--shm-prefix", prefix_, "--slots", "64"};
+  }
+  shm::ScanRingReader reader() {
+    shm::ReaderOptions r;
+    r.sensor = "roof";
+    r.name_prefix = prefix_;
+    r.start_at = shm::ReaderOptions::StartAt::kOldest;
+    r.liveness_period = std::chrono::milliseconds(20);
+    return shm::ScanRingReader(r);
+  }
+  // What the same driver code gives in-process, as fast as possible.
+  std::vector<Scan> offline(const std::filesystem::path& pcap) {
+    const config::RigConfig rig = config::loadRigConfig(rig_);
+    std::vector<Scan> scans;
+    std::atomic<bool> stop{false};
+    pipeline::SensorDriver d(rig.sensor("roof"), {pcap, 0.0}, stop, [&](Scan&& s) { scans.push_back(std::move(s)); });
+    d.run();
+    return scans;
+  }
+  TempDir dir_;
+  std::filesystem::path rig_;
+  std::string prefix_;
+};
+
+TEST_F(DriverCommand, PublishesEveryScanIntactIntoItsRing) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  const std::vector<Scan> expected = offline(pcap);
+  ASSERT_GE(expected.size(), 5u);
+  auto r = reader();  // attaches as soon as the driver creates the ring
+  RigcalProcess driver(driverArgs(pcap, "4"));
+  std::vector<Scan> got;
+  Scan scan;
+  while (true) {
+    const auto status = r.read(scan, std::chrono::seconds(10));
+    if (status == shm::ReadStatus::kScan) got.push_back(scan);
+    if (status != shm::ReadStatus::kScan) break;
+  }
+  const CommandResult result = driver.wait();
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find(std::to_string(expected.size()) + " scans published"), std::string::npos) << result.out;
+  ASSERT_EQ(got.size(), expected.size());
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i].stamp_ns, expected[i].stamp_ns) << i;
+    EXPECT_EQ(got[i].x, expected[i].x) << i;
+    EXPECT_EQ(got[i].offset_ns, expected[i].offset_ns) << i;
+  }
+  EXPECT_FALSE(std::filesystem::exists("/dev/shm/" + prefix_ + "roof")) << "clean shutdown unlinks the ring";
+}
+
+TEST_F(DriverCommand, KilledDriverIsReportedDeadAndARestartTakesOverItsRing) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  auto r = reader();
+  Scan scan;
+  {
+    RigcalProcess first(driverArgs(pcap, "0.5"));  // ~1 s of capture at half speed
+    ASSERT_EQ(r.read(scan, std::chrono::seconds(10)), shm::ReadStatus::kScan);
+    first.kill(SIGKILL);
+    EXPECT_EQ(first.wait().exit_code, 128 + SIGKILL);
+  }
+  // Drain what the dead writer left, then the reader reports it gone.
+  shm::ReadStatus status;
+  while ((status = r.read(scan, std::chrono::seconds(5))) == shm::ReadStatus::kScan) {
+  }
+  EXPECT_EQ(status, shm::ReadStatus::kWriterGone);
+  const std::uint64_t first_epoch = r.epoch();
+
+  RigcalProcess second(driverArgs(pcap, "max"));
+  std::size_t scans_after_restart = 0;
+  while (r.read(scan, std::chrono::seconds(10)) == shm::ReadStatus::kScan) ++scans_after_restart;
+  const CommandResult result = second.wait();
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("took over a stale ring"), std::string::npos) << result.out;
+  EXPECT_GT(r.epoch(), first_epoch);
+  EXPECT_EQ(scans_after_restart, offline(pcap).size());
+}
+
+TEST_F(DriverCommand, BadSensorAndMissingInputAreClearErrors) {
+  const auto unknown = runRigcal({"driver", "--config", rig_.string(), "--sensor", "rooff", "--live"});
+  EXPECT_EQ(unknown.exit_code, 3);
+  EXPECT_NE(unknown.err.find("no sensor named 'rooff'"), std::string::npos) << unknown.err;
+  EXPECT_EQ(runRigcal({"driver", "--config", rig_.string(), "--sensor", "roof"}).exit_code, 2);
+  EXPECT_EQ(runRigcal({"driver", "--config", rig_.string(), "--sensor", "roof", "--live", "--pcap",
+                       rig_.string()}).exit_code, 2);
+}
+
+}  // namespace
+}  // namespace rigcal::test
