@@ -6,7 +6,7 @@ TSAN      ?= build-tsan
 GENERATOR := $(shell command -v ninja >/dev/null 2>&1 && echo "-G Ninja")
 CTEST     := ctest --output-on-failure --timeout 600 -j $(JOBS)
 
-.PHONY: deps build test test-release test-asan test-tsan demo bench fuzz clean
+.PHONY: deps build test test-release test-asan test-tsan test-fuzz demo bench fuzz clean
 
 deps:
 	@scripts/install-deps
@@ -17,8 +17,10 @@ $(BUILD)/build.ninja $(BUILD)/Makefile:
 build: deps $(BUILD)/$(if $(GENERATOR),build.ninja,Makefile)
 	cmake --build $(BUILD) -j $(JOBS)
 
-# The whole suite: the Release build, then the ASan+UBSan build, then the TSan build.
-test: deps test-release test-asan test-tsan
+# The whole suite: the Release build, the ASan+UBSan build, the TSan build, then every fuzz harness for
+# a bounded time (clang, ASan+UBSan).
+FUZZ_CI_SECONDS ?= 10
+test: deps test-release test-asan test-tsan test-fuzz
 
 test-release: build
 	cd $(BUILD) && $(CTEST)
@@ -40,9 +42,12 @@ demo: build
 bench: build
 	@scripts/run-benchmarks $(BUILD)
 
+test-fuzz: deps
+	@scripts/run-fuzzers $(FUZZ_CI_SECONDS)
+
 # Every libFuzzer harness (clang, ASan+UBSan) for FUZZ_SECONDS each (default 30), in build-fuzz.
 fuzz: deps
 	@scripts/run-fuzzers $(FUZZ_SECONDS)
 
 clean:
-	rm -rf $(BUILD) $(ASAN) $(TSAN)
+	rm -rf $(BUILD) $(ASAN) $(TSAN) build-fuzz
