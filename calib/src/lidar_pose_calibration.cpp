@@ -165,6 +165,13 @@ LidarPoseResult calibrateLidarPose(LidarPoints points, const PoseTrajectory& tra
     // BOBYQA needs at least 2 variables; a single free one is searched with COBYLA.
     const auto algorithm = local.free.size() >= 2 ? nlopt::LN_BOBYQA : nlopt::LN_COBYLA;
     double cost = 0.0;
+    if (settings.coarse_local_stage) {
+      local.max_dist_sq = settings.global_knn_max_dist;
+      local.base = local.run(algorithm, lower, upper, settings.max_evals, settings.xtol, &cost,
+                             &result.coarse_status);
+      result.coarse_evaluations = local.evaluations;
+      local.max_dist_sq = settings.local_knn_max_dist;
+    }
     best = local.run(algorithm, lower, upper, settings.max_evals, settings.xtol, &cost,
                      &result.local_status);
     result.final_cost = cost;

@@ -13,6 +13,10 @@
 #include <utility>
 
 namespace rigcal::calib {
+namespace {
+// y/z cells per neighbour radius: finer columns let the y/z gap test skip more of the search box.
+constexpr int kColumnsPerRadius = 1;
+}  // namespace
 
 // n − 1 helper threads that sleep on a condition variable between jobs (no spinning on a 2-core
 // target); the caller runs part 0 itself.
@@ -93,9 +97,7 @@ LidarPoseObjective::LidarPoseObjective(const LidarPoints& points, const PoseTraj
   keys_tmp_.resize(n_);
   order_.resize(n_);
   order_tmp_.resize(n_);
-  sx_.resize(n_);
-  sy_.resize(n_);
-  sz_.resize(n_);
+  sorted_.resize(n_);
   sweep_split_.resize(threads_ + 1);
   cost_.resize(n_);
 }
@@ -169,8 +171,10 @@ void LidarPoseObjective::transform(int part, const Pose& T_pose_lidar) {
 }
 
 void LidarPoseObjective::sortByCell() {
-  // Cell keys packed x-fastest, so the cells (ix−1, ix, ix+1) of one (iy, iz) row are contiguous after
-  // sorting. A 1-cell margin keeps every neighbour key non-negative.
+  // Key = (iz, iy, qx): y and z in cells of radius/kColumnsPerRadius, x quantised finely, packed
+  // x-fastest. After sorting, each (iy, iz) column is one contiguous run ordered by x, so a query scans
+  // a column outwards from its own x and stops once |Δx| alone exceeds the best distance so far.
+  // A margin of kColumnsPerRadius cells in y and z keeps every neighbour key non-negative.
   std::int64_t count[3];
   for (int a = 0; a < 3; ++a) {
     float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
@@ -178,8 +182,10 @@ void LidarPoseObjective::sortByCell() {
       lo = std::min(lo, part_min_[3 * p + a]);
       hi = std::max(hi, part_max_[3 * p + a]);
     }
-    origin_[a] = static_cast<std::int64_t>(std::floor(lo * inv_cell_)) - 1;
-    count[a] = static_cast<std::int64_t>(std::floor(hi * inv_cell_)) - origin_[a] + 2;
+    const float inv = a == 0 ? inv_quantum_ : inv_cell_;
+    const std::int64_t margin = a == 0 ? 1 : kColumnsPerRadius;
+    origin_[a] = static_cast<std::int64_t>(std::floor(lo * inv)) - margin;
+    count[a] = static_cast<std::int64_t>(std::floor(hi * inv)) - origin_[a] + 1 + margin;
   }
   const double cells = static_cast<double>(count[0]) * static_cast<double>(count[1]) *
                        static_cast<double>(count[2]);
@@ -193,11 +199,11 @@ void LidarPoseObjective::sortByCell() {
   workers_->run([&](int part) {
     const auto [begin, end] = pointRange(part);
     for (std::size_t i = begin; i < end; ++i) {
-      const auto ix = static_cast<std::int64_t>(std::floor(wx_[i] * inv_cell_)) - origin_[0];
+      const auto qx = static_cast<std::int64_t>(std::floor(wx_[i] * inv_quantum_)) - origin_[0];
       const auto iy = static_cast<std::int64_t>(std::floor(wy_[i] * inv_cell_)) - origin_[1];
       const auto iz = static_cast<std::int64_t>(std::floor(wz_[i] * inv_cell_)) - origin_[2];
       keys_[i] = static_cast<std::uint64_t>(iz) * nxy_ + static_cast<std::uint64_t>(iy) * nx_ +
-                 static_cast<std::uint64_t>(ix);
+                 static_cast<std::uint64_t>(qx);
       order_[i] = static_cast<std::uint32_t>(i);
     }
   });
@@ -220,77 +226,78 @@ void LidarPoseObjective::sortByCell() {
     order_.swap(order_tmp_);
   }
   for (std::size_t k = 0; k < n_; ++k) {
-    sx_[k] = wx_[order_[k]];
-    sy_[k] = wy_[order_[k]];
-    sz_[k] = wz_[order_[k]];
+    const std::uint32_t i = order_[k];
+    sorted_[k] = SortedPoint{keys_[k], wx_[i], wy_[i], wz_[i], 0.0f};
   }
-  // Sweep parts start on cell boundaries so each part owns whole cells.
-  sweep_split_.front() = 0;
-  sweep_split_.back() = n_;
-  for (int p = 1; p < threads_; ++p) {
-    std::size_t k = std::max(sweep_split_[p - 1], n_ * static_cast<std::size_t>(p) / threads_);
-    while (k > sweep_split_[p - 1] && k < n_ && keys_[k] == keys_[k - 1]) ++k;
-    sweep_split_[p] = k;
-  }
+  for (int p = 0; p <= threads_; ++p) sweep_split_[p] = n_ * static_cast<std::size_t>(p) / threads_;
 }
 
 void LidarPoseObjective::sweep(int part) {
   const std::size_t begin = sweep_split_[part], end = sweep_split_[part + 1];
   if (begin >= end) return;
-  const float max_sq = max_sq_;
-  // The 9 (dy, dz) rows around a cell, own row first so the nearest neighbour is usually found early
-  // and the other rows are skipped by their distance bound.
-  struct Row {
+  // The (2m+1)² neighbouring (dy, dz) columns, nearest first (own column, then by |dy| + |dz|), so
+  // the nearest neighbour is usually found early and farther columns are skipped by their gap.
+  struct Column {
     int dy, dz;
-    std::int64_t offset;
-    std::size_t lo, hi;  // sorted positions of the cells (ix−1 .. ix+1) of this row
+    std::uint64_t offset;  // key offset of (iy+dy, iz+dz, same qx), wrapping arithmetic
+    std::size_t cursor;    // first sorted position with key >= query key + offset
   };
-  std::array<Row, 9> rows;
+  constexpr int m = kColumnsPerRadius;
+  std::array<Column, (2 * m + 1) * (2 * m + 1)> columns;
   {
-    int r = 0;
-    for (int dz : {0, -1, 1})
-      for (int dy : {0, -1, 1})
-        rows[r++] = Row{dy, dz,
-                        static_cast<std::int64_t>(dz) * static_cast<std::int64_t>(nxy_) +
-                            static_cast<std::int64_t>(dy) * static_cast<std::int64_t>(nx_),
-                        0, 0};
-  }
-  const std::uint64_t first_key = keys_[begin];
-  for (Row& row : rows) {
-    const auto lo_key = static_cast<std::uint64_t>(static_cast<std::int64_t>(first_key) + row.offset - 1);
-    row.lo = static_cast<std::size_t>(std::lower_bound(keys_.begin(), keys_.end(), lo_key) - keys_.begin());
-    row.hi = row.lo;
-  }
-  for (std::size_t k = begin; k < end;) {
-    const std::uint64_t key = keys_[k];
-    std::size_t cell_end = k + 1;
-    while (cell_end < end && keys_[cell_end] == key) ++cell_end;
-    for (Row& row : rows) {  // keys only grow: every cursor moves forward
-      const auto centre = static_cast<std::uint64_t>(static_cast<std::int64_t>(key) + row.offset);
-      while (row.lo < n_ && keys_[row.lo] < centre - 1) ++row.lo;
-      row.hi = std::max(row.hi, row.lo);
-      while (row.hi < n_ && keys_[row.hi] <= centre + 1) ++row.hi;
-    }
-    for (std::size_t i = k; i < cell_end; ++i) {
-      const float x = sx_[i], y = sy_[i], z = sz_[i];
-      const float fy = y * inv_cell_ - std::floor(y * inv_cell_);
-      const float fz = z * inv_cell_ - std::floor(z * inv_cell_);
-      // Smallest possible |Δy|, |Δz| to a neighbouring row: to this cell's lower or upper face.
-      const float gap_y[3] = {fy * cell_, 0.0f, (1.0f - fy) * cell_};
-      const float gap_z[3] = {fz * cell_, 0.0f, (1.0f - fz) * cell_};
-      float best = max_sq;
-      for (const Row& row : rows) {
-        const float gy = gap_y[row.dy + 1], gz = gap_z[row.dz + 1];
-        if (gy * gy + gz * gz >= best) continue;
-        for (std::size_t j = row.lo; j < row.hi; ++j) {
-          const float dx = sx_[j] - x, dy = sy_[j] - y, dz = sz_[j] - z;
-          const float d2 = dx * dx + dy * dy + dz * dz;
-          if (d2 < best && j != i) best = d2;
+    std::size_t c = 0;
+    for (int ring = 0; ring <= 2 * m; ++ring)
+      for (int dz = -m; dz <= m; ++dz)
+        for (int dy = -m; dy <= m; ++dy) {
+          if (std::abs(dy) + std::abs(dz) != ring) continue;
+          const std::int64_t off = static_cast<std::int64_t>(dz) * static_cast<std::int64_t>(nxy_) +
+                                   static_cast<std::int64_t>(dy) * static_cast<std::int64_t>(nx_);
+          const auto target = sorted_[begin].key + static_cast<std::uint64_t>(off);
+          columns[c++] = Column{dy, dz, static_cast<std::uint64_t>(off),
+                                static_cast<std::size_t>(
+                                    std::lower_bound(keys_.begin(), keys_.end(), target) - keys_.begin())};
         }
-      }
-      cost_[i] = best;
+  }
+  const float slack = 2.0f * quantum_;  // x is only sorted to within a quantum (plus float rounding)
+  for (std::size_t i = begin; i < end; ++i) {
+    const SortedPoint& q = sorted_[i];
+    const std::uint64_t key = q.key;
+    const std::uint64_t column_base = key - key % nx_;
+    const float x = q.x, y = q.y, z = q.z;
+    const float fy = y * inv_cell_ - std::floor(y * inv_cell_);
+    const float fz = z * inv_cell_ - std::floor(z * inv_cell_);
+    // Smallest possible |Δy| (|Δz|) to column dy (dz): the distance to the nearer face of that cell.
+    std::array<float, 2 * m + 1> gap_y, gap_z;
+    for (int d = -m; d <= m; ++d) {
+      gap_y[d + m] = d < 0 ? (fy + static_cast<float>(-d - 1)) * cell_ : d > 0 ? (static_cast<float>(d) - fy) * cell_ : 0.0f;
+      gap_z[d + m] = d < 0 ? (fz + static_cast<float>(-d - 1)) * cell_ : d > 0 ? (static_cast<float>(d) - fz) * cell_ : 0.0f;
     }
-    k = cell_end;
+    float best = max_sq_;
+    for (Column& col : columns) {
+      const float gy = gap_y[col.dy + m], gz = gap_z[col.dz + m];
+      const float floor_yz = gy * gy + gz * gz;
+      if (floor_yz >= best) continue;
+      const std::uint64_t target = key + col.offset;
+      while (col.cursor < n_ && sorted_[col.cursor].key < target) ++col.cursor;  // keys only grow
+      const std::uint64_t lo = column_base + col.offset, hi = lo + nx_;
+      for (std::size_t j = col.cursor; j < n_ && sorted_[j].key < hi; ++j) {  // forward: x grows
+        const SortedPoint& p = sorted_[j];
+        const float dx = p.x - x;
+        if (dx > slack && (dx - slack) * (dx - slack) + floor_yz >= best) break;
+        const float dy = p.y - y, dz = p.z - z;
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < best && j != i) best = d2;
+      }
+      for (std::size_t j = col.cursor; j-- > 0 && sorted_[j].key >= lo;) {  // backward: x shrinks
+        const SortedPoint& p = sorted_[j];
+        const float dx = x - p.x;
+        if (dx > slack && (dx - slack) * (dx - slack) + floor_yz >= best) break;
+        const float dy = p.y - y, dz = p.z - z;
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < best && j != i) best = d2;
+      }
+    }
+    cost_[i] = best;
   }
 }
 
@@ -299,8 +306,11 @@ double LidarPoseObjective::evaluate(const Pose& T_pose_lidar, double time_offset
   ++evaluations_;
   updatePoses(time_offset_s);
   max_sq_ = static_cast<float>(max_dist_sq);
-  cell_ = static_cast<float>(std::sqrt(max_dist_sq));
+  const float radius = static_cast<float>(std::sqrt(max_dist_sq));
+  cell_ = radius / kColumnsPerRadius;
   inv_cell_ = 1.0f / cell_;
+  quantum_ = radius / 32.0f;
+  inv_quantum_ = 1.0f / quantum_;
   workers_->run([&](int part) { transform(part, T_pose_lidar); });
   sortByCell();
   workers_->run([&](int part) { sweep(part); });

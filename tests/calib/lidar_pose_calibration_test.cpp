@@ -29,7 +29,8 @@ Errors errorsOf(const LidarPoseResult& r, const test::SyntheticOptions& o) {
 void print(const char* what, const LidarPoseResult& r, const Errors& e) {
   std::cout << what << ": error " << 100 * e.translation_m << " cm, " << e.rotation_deg << " deg, " << e.time_ms
             << " ms; " << r.points.size() << " points, evaluations " << r.global_evaluations << " + "
-            << r.local_evaluations << " (" << r.global_status << ", " << r.local_status << "), time "
+            << r.coarse_evaluations << " + " << r.local_evaluations - r.coarse_evaluations << " ("
+            << r.global_status << ", " << r.coarse_status << ", " << r.local_status << "), time "
             << r.global_seconds << " + " << r.local_seconds << " s\n"
             << r.observability.text();
 }
@@ -42,41 +43,59 @@ bool bitIdentical(const LidarPoseResult& a, const LidarPoseResult& b) {
          a.local_evaluations == b.local_evaluations && a.global_evaluations == b.global_evaluations;
 }
 
-test::SyntheticOptions options() {
+// 8 s of a rig shaken by ±15° roll and ±12° pitch while driving a figure of eight, lidar mounted at
+// (0.5, −0.2, 0.3) m, (3°, −4°, 10°), 15 ms behind the pose clock, 3 mm range noise; 5 % of the returns
+// (~51 000 points). z is the weakest parameter: it is seen only through the small sideways shift that
+// tilting gives a lever arm along z, so it needs this much data (with 1 % it lands 2–5 cm off).
+// Sanitizer builds check memory and threads, not accuracy: they use 1 % and loose tolerances.
+test::SyntheticOptions accuracyOptions() {
   test::SyntheticOptions o;
-  if (kSanitized) o.duration_s = 6.0;  // sanitizers run ~5-20× slower
+  o.duration_s = 8.0;
+  o.selection.keep_points_ratio = kSanitized ? 0.01 : 0.05;
   return o;
 }
 
-TEST(LidarPoseCalibration, RecoversExtrinsicAndTimeOffsetIdenticallyOnEveryRunAndThreadCount) {
-  const test::SyntheticOptions o = options();
+TEST(LidarPoseCalibration, RecoversExtrinsicAndTimeOffsetOnAShakenRig) {
+  const test::SyntheticOptions o = accuracyOptions();
   const test::SyntheticRecording rec = test::makeSyntheticRecording(o);
   const PoseTrajectory traj(rec.pose_stamps, rec.poses);
-  LidarPoseSettings s;  // lidar_align's defaults: global from identity, 200 + 200 evaluations
+  LidarPoseSettings s;  // lidar_align's defaults: global from identity, then local, 200 evaluations each
   s.selection = o.selection;
-  s.threads = 2;
   const LidarPoseResult r = calibrateLidarPose(rec.scans, traj, s);
   const Errors e = errorsOf(r, o);
   print("synthetic", r, e);
   for (std::size_t i = 0; i < kLidarPoseParams; ++i)
     EXPECT_FALSE(r.observability.poorly_constrained[i] || r.held[i]) << i;
-  EXPECT_LT(e.translation_m, 0.02);
-  EXPECT_LT(e.rotation_deg, 0.1);
-  EXPECT_LT(e.time_ms, 1.0);
+  const double scale = kSanitized ? 5.0 : 1.0;
+  EXPECT_LT(e.translation_m, 0.02 * scale);
+  EXPECT_LT(e.rotation_deg, 0.1 * scale);
+  EXPECT_LT(e.time_ms, 1.0 * scale);
   EXPECT_LT(r.final_cost, r.initial_cost);
   EXPECT_EQ(r.points.counts.outside_poses, 0u);
   EXPECT_EQ(r.points.counts.kept, r.points.size());
-  EXPECT_GT(r.points.size(), 5000u);
+  EXPECT_GT(r.points.size(), kSanitized ? 7000u : 45000u);
+}
 
-  const LidarPoseResult again = calibrateLidarPose(rec.scans, traj, s);
-  EXPECT_TRUE(bitIdentical(r, again)) << "a second run differs";
+TEST(LidarPoseCalibration, RepeatedRunsAndThreadCountsGiveBitIdenticalResults) {
+  test::SyntheticOptions o;  // small: identity, not accuracy, is the point here
+  o.duration_s = 3.0;
+  o.columns = 600;
+  o.selection.keep_points_ratio = 0.05;
+  const test::SyntheticRecording rec = test::makeSyntheticRecording(o);
+  const PoseTrajectory traj(rec.pose_stamps, rec.poses);
+  LidarPoseSettings s;
+  s.selection = o.selection;
+  s.threads = 2;
+  const LidarPoseResult r = calibrateLidarPose(rec.scans, traj, s);
+  EXPECT_GT(r.local_evaluations, 20u);
+  EXPECT_TRUE(bitIdentical(r, calibrateLidarPose(rec.scans, traj, s))) << "a second run differs";
   s.threads = 1;
-  const LidarPoseResult single = calibrateLidarPose(rec.scans, traj, s);
-  EXPECT_TRUE(bitIdentical(r, single)) << "1 thread differs from 2";
+  EXPECT_TRUE(bitIdentical(r, calibrateLidarPose(rec.scans, traj, s))) << "1 thread differs from 2";
 }
 
 TEST(LidarPoseCalibration, PlanarMotionFlagsRollPitchAndZAndHoldsThemAtTheInitialGuess) {
-  test::SyntheticOptions o = options();
+  test::SyntheticOptions o;  // 10 s, lidar_align's 1 % subset
+  if (kSanitized) o.duration_s = 6.0;
   o.planar = true;
   // Roll and pitch are 0 so that holding them at the (identity) guess is right; z is not, and stays 0.
   o.T_pose_lidar = fromXyzRpy({0.5, -0.2, 0.3, 0.0, 0.0, deg2rad(10.0)});
@@ -108,10 +127,11 @@ TEST(LidarPoseCalibration, PlanarMotionFlagsRollPitchAndZAndHoldsThemAtTheInitia
   EXPECT_NEAR(got.roll, 0.0, 1e-12);
   EXPECT_NEAR(got.pitch, 0.0, 1e-12);
   // What the motion does determine is still recovered.
-  EXPECT_NEAR(got.x, 0.5, 0.02);
-  EXPECT_NEAR(got.y, -0.2, 0.02);
-  EXPECT_NEAR(rad2deg(got.yaw), 10.0, 0.1);
-  EXPECT_LT(e.time_ms, 1.0);
+  const double scale = kSanitized ? 5.0 : 1.0;
+  EXPECT_NEAR(got.x, 0.5, 0.02 * scale);
+  EXPECT_NEAR(got.y, -0.2, 0.02 * scale);
+  EXPECT_NEAR(rad2deg(got.yaw), 10.0, 0.1 * scale);
+  EXPECT_LT(e.time_ms, 1.0 * scale);
 }
 
 TEST(LidarPoseCalibration, PosesNotCoveringTheLidarTimeRangeAreAClearError) {

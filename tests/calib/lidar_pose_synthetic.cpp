@@ -87,8 +87,8 @@ Pose syntheticPose(const SyntheticOptions& o, double t) {
   v.yaw = std::atan2(2.0 * B * w * std::cos(2.0 * w * t), A * w * std::cos(w * t));
   v.z = 1.0;
   if (!o.planar) {
-    v.roll = deg2rad(8.0) * std::sin(2.0 * M_PI * 0.37 * t);
-    v.pitch = deg2rad(6.0) * std::sin(2.0 * M_PI * 0.23 * t + 0.5);
+    v.roll = deg2rad(o.roll_amplitude_deg) * std::sin(2.0 * M_PI * 0.37 * t);
+    v.pitch = deg2rad(o.pitch_amplitude_deg) * std::sin(2.0 * M_PI * 0.23 * t + 0.5);
     v.z += 0.15 * std::sin(2.0 * M_PI * 0.31 * t);
   }
   return fromXyzRpy(v);

@@ -14,6 +14,7 @@ namespace rigcal::test {
 
 struct SyntheticOptions {
   bool planar = false;         // no roll, pitch or heave (a vehicle on flat ground)
+  double roll_amplitude_deg = 15.0, pitch_amplitude_deg = 12.0;  // unless planar (a well-shaken rig)
   double duration_s = 10.0;    // lidar recording length (pose coverage adds a margin)
   double pose_rate_hz = 100.0;
   double pose_margin_s = 0.5;  // poses start this long before the first lidar point (and end after)

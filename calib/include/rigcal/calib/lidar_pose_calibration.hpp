@@ -39,6 +39,7 @@ struct LidarPoseSettings {
   bool time_cal = true;              // estimate the time offset
   int threads = 2;
   ObservabilitySettings observability;
+  bool coarse_local_stage = true;  // run the local stage at the global cap first (see above)
   bool hold_poorly_constrained = true;  // false: optimise them anyway (lidar_align's behaviour)
   std::size_t min_points = 100;         // fewer usable points is an error
 };
@@ -51,8 +52,8 @@ struct LidarPoseResult {
   double initial_cost = 0.0;  // at the initial guess, local cap
   double global_cost = 0.0;   // best of stage 1 (global cap); 0 when skipped
   double final_cost = 0.0;    // best of stage 2 (local cap)
-  std::size_t global_evaluations = 0, local_evaluations = 0;
-  std::string global_status = "skipped", local_status = "skipped";  // NLopt result
+  std::size_t global_evaluations = 0, coarse_evaluations = 0, local_evaluations = 0;  // local includes coarse
+  std::string global_status = "skipped", coarse_status = "skipped", local_status = "skipped";  // NLopt
 
   double select_seconds = 0.0, global_seconds = 0.0, local_seconds = 0.0, total_seconds = 0.0;
 

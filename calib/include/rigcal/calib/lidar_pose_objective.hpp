@@ -6,11 +6,12 @@
 //
 // How it differs from lidar_align (which copies the cloud into a PCL cloud, rebuilds a kd-tree and
 // copies cloud and tree again for every batch of 1000 queries): only neighbours closer than
-// sqrt(max_dist_sq) change the sum, so the cloud is bucketed into cubic cells of that size, sorted by
-// cell (radix sort) and searched in the 3×3×3 cells around each point with monotonic cursors. All
-// buffers are allocated once; poses are re-interpolated only when the time offset changes; the work is
-// split over 1..n threads and reduced in a fixed order, so the result is bit-identical for any thread
-// count and run.
+// r = sqrt(max_dist_sq) change the sum, so the cloud is radix-sorted by (z cell, y cell, fine x) with
+// cells of size r/2. Each (y, z) column is then one run ordered by x; a query visits its own and the 24
+// neighbouring columns (found by cursors that only move forward), skips a column whose y/z gap already
+// exceeds the best distance, and scans outwards in x until |Δx| alone does. All buffers are allocated
+// once; poses are re-interpolated only when the time offset changes; the work is split over 1..n
+// threads and reduced in a fixed order, so the result is bit-identical for any thread count and run.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -69,15 +70,19 @@ class LidarPoseObjective {
   std::vector<float> wx_, wy_, wz_;
   std::vector<float> part_min_, part_max_;  // per part: bounding box (x, y, z)
   float max_sq_ = 1.0f;
-  float inv_cell_ = 1.0f;
-  float cell_ = 1.0f;
-  std::int64_t origin_[3] = {0, 0, 0};  // cell index of the lowest cell, minus the 1-cell margin
-  std::uint64_t nx_ = 0, nxy_ = 0;
+  float inv_cell_ = 1.0f, cell_ = 1.0f;        // y, z cells: a fraction of the neighbour radius
+  float inv_quantum_ = 1.0f, quantum_ = 1.0f;  // x quantum: a 32nd of the radius
+  std::int64_t origin_[3] = {0, 0, 0};  // lowest x quantum / y, z cell, minus a margin
+  std::uint64_t nx_ = 0, nxy_ = 0;      // x quanta per column, quanta per z layer
 
   // Radix-sorted (cell key, point) pairs and the cloud gathered in that order.
   std::vector<std::uint64_t> keys_, keys_tmp_;
   std::vector<std::uint32_t> order_, order_tmp_;
-  std::vector<float> sx_, sy_, sz_;
+  struct SortedPoint {  // what a neighbour test reads, in one 24-byte record
+    std::uint64_t key;
+    float x, y, z, unused;
+  };
+  std::vector<SortedPoint> sorted_;
   std::vector<std::size_t> sweep_split_;  // part p sweeps sorted positions [split[p], split[p+1])
   std::vector<float> cost_;               // per sorted position
 };
