@@ -52,7 +52,8 @@ std::string lidarPoseCalibrationText(const LidarPoseResult& r, const Eigen::Vect
     << ", " << rad2deg(v.yaw) << "]\n\n";
   o << "Cost (sum of min(d^2, max) in m^2): initial " << r.initial_cost << ", global " << r.global_cost
     << " (" << r.global_evaluations << " evaluations, " << r.global_status << "), final "
-    << r.final_cost << " (" << r.local_evaluations << " evaluations, " << r.local_status << ")\n";
+    << r.final_cost << " (" << r.local_evaluations << " evaluations, " << r.coarse_evaluations
+    << " of them at the global cap: " << r.coarse_status << ", " << r.local_status << ")\n";
   o << std::setprecision(4) << "Time (s): selection " << r.select_seconds << ", global "
     << r.global_seconds << ", local " << r.local_seconds << ", total " << r.total_seconds << "\n";
   const auto& c = r.points.counts;

@@ -7,10 +7,15 @@
 //     neighbour cap global_knn_max_dist (m²). Skipped when `local` is set.
 //  2. local: NLopt LN_BOBYQA over x, y, z (initial ± translation_range), rotation (exp(δ)·R_global,
 //     δ ∈ ±angular_range) and the time offset (± max_time_offset), cap local_knn_max_dist (m²).
-// Both stop at max_evals evaluations or xtol. Everything is deterministic: the same input gives a
-// bit-identical result on every run and for any thread count.
-// Better than lidar_align: parameters the motion does not excite (lidar_pose_observability.hpp) are held
-// at their initial value and reported instead of being returned as noise.
+// Each NLopt run stops at max_evals evaluations or xtol. Everything is deterministic: the same input
+// gives a bit-identical result on every run and for any thread count.
+// Better than lidar_align:
+//  - parameters the motion does not excite (lidar_pose_observability.hpp) are held at their initial
+//    value and reported instead of being returned as noise;
+//  - coarse_local_stage (default on): stage 2 first runs at the global cap, then at the local one.
+//    Stage 1 leaves the translation at its initial value, and a lever arm more than ~sqrt(0.1) m from
+//    it is outside the local cap's basin: lidar_align's local stage then stops in a wrong minimum
+//    (on our synthetic rig, z 33–48 cm off with 1 % of the points).
 #include <array>
 #include <string>
 #include <vector>
@@ -39,7 +44,7 @@ struct LidarPoseSettings {
   bool time_cal = true;              // estimate the time offset
   int threads = 2;
   ObservabilitySettings observability;
-  bool coarse_local_stage = true;  // run the local stage at the global cap first (see above)
+  bool coarse_local_stage = true;  // run stage 2 at the global cap first (see above)
   bool hold_poorly_constrained = true;  // false: optimise them anyway (lidar_align's behaviour)
   std::size_t min_points = 100;         // fewer usable points is an error
 };

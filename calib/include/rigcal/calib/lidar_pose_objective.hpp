@@ -7,7 +7,7 @@
 // How it differs from lidar_align (which copies the cloud into a PCL cloud, rebuilds a kd-tree and
 // copies cloud and tree again for every batch of 1000 queries): only neighbours closer than
 // r = sqrt(max_dist_sq) change the sum, so the cloud is radix-sorted by (z cell, y cell, fine x) with
-// cells of size r/2. Each (y, z) column is then one run ordered by x; a query visits its own and the 24
+// cells of size r. Each (y, z) column is then one run ordered by x; a query visits its own and the 8
 // neighbouring columns (found by cursors that only move forward), skips a column whose y/z gap already
 // exceeds the best distance, and scans outwards in x until |Δx| alone does. All buffers are allocated
 // once; poses are re-interpolated only when the time offset changes; the work is split over 1..n
@@ -78,9 +78,11 @@ class LidarPoseObjective {
   // Radix-sorted (cell key, point) pairs and the cloud gathered in that order.
   std::vector<std::uint64_t> keys_, keys_tmp_;
   std::vector<std::uint32_t> order_, order_tmp_;
-  struct SortedPoint {  // what a neighbour test reads, in one 24-byte record
+  struct SortedPoint {  // what a query and a neighbour test read, in one 32-byte record
     std::uint64_t key;
-    float x, y, z, unused;
+    float x, y, z;
+    float fy, fz;      // position inside its y, z cell, in [0, 1)
+    std::uint32_t qx;  // x quantum (the low part of key)
   };
   std::vector<SortedPoint> sorted_;
   std::vector<std::size_t> sweep_split_;  // part p sweeps sorted positions [split[p], split[p+1])
