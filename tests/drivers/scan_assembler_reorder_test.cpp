@@ -4,29 +4,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <random>
 
+#include "allocation_counter.hpp"
 #include "rigcal/drivers/scan_assembler.hpp"
-
-#if defined(__GNUC__) && !defined(__clang__)
-// GCC pairs the replaced operator new with free() below after inlining and warns; they do match.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-
-// Counts heap allocations, to check that the reorder window allocates nothing in steady state.
-namespace {
-std::atomic<std::uint64_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace rigcal::drivers {
 namespace {
@@ -167,6 +148,7 @@ TEST(ScanAssemblerReorder, FlushStartsAFreshOrderForTheNextInput) {
 }
 
 TEST(ScanAssemblerReorder, SteadyStateAllocatesNothingBetweenSweeps) {
+  RIGCAL_REQUIRE_ALLOCATION_COUNTING();
   std::vector<Scan> scans;
   scans.reserve(16);
   AssemblerConfig config{90.0};
@@ -184,9 +166,9 @@ TEST(ScanAssemblerReorder, SteadyStateAllocatesNothingBetweenSweeps) {
   for (; i <= 30; ++i) a.add(packets[std::size_t(order[i])]);
   const std::size_t scans_before = scans.size();
   // Arrivals 31..39 release packets 23..31: no cut, so nothing may allocate.
-  const std::uint64_t before = g_allocations.load();
+  test::AllocationCounter::start();
   for (; i < 40; ++i) a.add(packets[std::size_t(order[i])]);
-  const std::uint64_t during = g_allocations.load() - before;
+  const std::uint64_t during = test::AllocationCounter::stop();
   EXPECT_EQ(scans.size(), scans_before) << "no sweep was emitted in the measured stretch";
   EXPECT_EQ(during, 0u) << "add() allocated in steady state";
   for (; i < 60; ++i) a.add(packets[std::size_t(order[i])]);

@@ -1,4 +1,5 @@
 #pragma once
+#include "allocation_counter.hpp"
 // What the ring tests share: a segment-name prefix no other test (or test run) uses, removed with every
 // segment under it when the test ends; the peer executable; the allocation counter.
 #include <atomic>
@@ -26,10 +27,6 @@ class UniquePrefix {
 /// The ring_peer executable built next to the tests.
 std::string peerPath();
 
-/// Counts operator new calls made while counting is enabled (defined in alloc_counter.cpp).
-struct AllocationCounter {
-  static void start();
-  static std::uint64_t stop();  // allocations since start()
-};
+using rigcal::test::AllocationCounter;  // tests/support/allocation_counter.hpp
 
 }  // namespace rigcal::shm::test

@@ -257,6 +257,7 @@ TEST(ScanRing, ReaderFollowsANewWriterIntoANewSegment) {
 }
 
 TEST(ScanRing, SteadyStatePublishAndReadDoNotAllocate) {
+  RIGCAL_REQUIRE_ALLOCATION_COUNTING();
   test::UniquePrefix prefix;
   ScanRingWriter writer(writerOptions(prefix, 5000, 4));
   ScanRingReader reader(readerOptions(prefix));
