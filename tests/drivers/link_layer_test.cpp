@@ -47,6 +47,29 @@ TEST(LinkLayer, ParsesEthernetWithStackedVlanTags) {
   }
 }
 
+TEST(LinkLayer, ParsesLinuxCookedCapturesV1AndV2) {
+  const auto eth = frame(udpDatagram(12), 0, false, 0);
+  const std::vector<std::uint8_t> ip(eth.begin() + 14, eth.end());
+  std::vector<std::uint8_t> sll1(16, 0);  // SLL v1: protocol in bytes 14..15
+  sll1[14] = 0x08;
+  sll1.insert(sll1.end(), ip.begin(), ip.end());
+  std::vector<std::uint8_t> sll2(20, 0);  // SLL v2: protocol in bytes 0..1
+  sll2[0] = 0x08;
+  sll2.insert(sll2.end(), ip.begin(), ip.end());
+  for (const auto& [link, bytes] : {std::pair{LinkType::kLinuxSll, sll1}, std::pair{LinkType::kLinuxSll2, sll2}}) {
+    Ipv4Header header;
+    ASSERT_EQ(parseFrame(link, bytes, header), FrameResult::kIpv4);
+    const auto udp = parseUdp(header.payload);
+    ASSERT_TRUE(udp);
+    EXPECT_EQ(udp->payload.size(), 12u);
+  }
+  std::vector<std::uint8_t> arp = sll1;
+  arp[15] = 0x06;  // 0x0806: ARP
+  Ipv4Header header;
+  EXPECT_EQ(parseFrame(LinkType::kLinuxSll, arp, header), FrameResult::kNotIpv4);
+  EXPECT_EQ(parseFrame(LinkType::kRaw, ip, header), FrameResult::kIpv4);
+}
+
 TEST(LinkLayer, TruncatedFramesAreMalformedAtEveryLength) {
   const auto f = frame(udpDatagram(40), 0, false, 1);
   for (std::size_t n = 0; n < f.size(); ++n) {

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <set>
 
 #include "rigcal/drivers/pcap_source.hpp"
@@ -75,6 +77,56 @@ TEST(PcapSource, TruncatedCaptureKeepsPacketsBeforeTheCutAndWarns) {
   EXPECT_LT(n, full);
   EXPECT_NE(source.warning().find("cut.pcap"), std::string::npos) << source.warning();
   EXPECT_EQ(source.warning().find('\n'), std::string::npos);
+}
+
+// Rewrites a classic little-endian microsecond pcap as pcapng (SHB, IDB, one EPB per record).
+void convertToPcapng(const std::filesystem::path& in, const std::filesystem::path& out) {
+  std::ifstream src(in, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(src)), {});
+  std::uint32_t magic, linktype, snaplen;
+  std::memcpy(&magic, bytes.data(), 4);
+  ASSERT_EQ(magic, 0xa1b2c3d4u) << "test expects a little-endian microsecond pcap";
+  std::memcpy(&snaplen, bytes.data() + 16, 4);
+  std::memcpy(&linktype, bytes.data() + 20, 4);
+  std::ofstream dst(out, std::ios::binary);
+  const auto u32 = [&](std::uint32_t v) { dst.write(reinterpret_cast<const char*>(&v), 4); };
+  const auto u16 = [&](std::uint16_t v) { dst.write(reinterpret_cast<const char*>(&v), 2); };
+  u32(0x0A0D0D0A), u32(28), u32(0x1A2B3C4D), u16(1), u16(0), u32(0xffffffff), u32(0xffffffff), u32(28);
+  u32(1), u32(20), u16(std::uint16_t(linktype)), u16(0), u32(snaplen), u32(20);
+  for (std::size_t off = 24; off + 16 <= bytes.size();) {
+    std::uint32_t sec, usec, caplen, origlen;
+    std::memcpy(&sec, &bytes[off], 4);
+    std::memcpy(&usec, &bytes[off + 4], 4);
+    std::memcpy(&caplen, &bytes[off + 8], 4);
+    std::memcpy(&origlen, &bytes[off + 12], 4);
+    const std::uint64_t ts = std::uint64_t(sec) * 1000000 + usec;  // default if_tsresol: µs
+    const std::uint32_t padded = (caplen + 3) & ~3u;
+    const std::uint32_t total = 32 + padded;
+    u32(6), u32(total), u32(0), u32(std::uint32_t(ts >> 32)), u32(std::uint32_t(ts)), u32(caplen), u32(origlen);
+    dst.write(&bytes[off + 16], caplen);
+    for (std::uint32_t p = caplen; p < padded; ++p) dst.put(0);
+    u32(total);
+    off += 16 + caplen;
+  }
+}
+
+TEST(PcapSource, ReadsPcapngLikeClassicPcap) {
+  RIGCAL_REQUIRE_DATA(path, "ouster/OS-1-32-G_v2.1.1_1024x10.pcap");
+  test::TempDir dir;
+  convertToPcapng(path, dir / "same.pcapng");
+  PcapSource classic(path), ng(dir / "same.pcapng");
+  std::size_t n = 0;
+  while (auto a = classic.next()) {
+    const std::vector<std::uint8_t> pa(a->payload.begin(), a->payload.end());
+    const TimeNs ta = a->receive_ns;
+    auto b = ng.next();
+    ASSERT_TRUE(b.has_value()) << "datagram " << n;
+    EXPECT_EQ(std::vector<std::uint8_t>(b->payload.begin(), b->payload.end()), pa) << n;
+    EXPECT_EQ(b->receive_ns, ta) << n;
+    ++n;
+  }
+  EXPECT_FALSE(ng.next().has_value());
+  EXPECT_GT(n, 60u);  // fragmented datagrams reassemble from pcapng too
 }
 
 TEST(PcapSource, NonCaptureFileIsRefusedNamingIt) {
