@@ -150,9 +150,10 @@ LidarPoseResult calibrateLidarPose(LidarPoints points, const PoseTrajectory& tra
   for (std::size_t i = 0; i < kLidarPoseParams; ++i)
     if (!result.held[i]) local.free.push_back(i);
   Params best = initial;
-  result.final_cost = objective.evaluate(toPose(initial, R_global), initial_offset,
-                                         settings.local_knn_max_dist);
-  if (!local.free.empty()) {
+  if (local.free.empty()) {  // everything held: report the cost of the guess
+    result.final_cost = objective.evaluate(toPose(initial, R_global), initial_offset,
+                                           settings.local_knn_max_dist);
+  } else {
     Params lower = initial, upper = initial;
     for (std::size_t i = 0; i < 3; ++i) {
       lower[i] = initial[i] - settings.translation_range;

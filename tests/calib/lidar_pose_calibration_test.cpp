@@ -134,6 +134,30 @@ TEST(LidarPoseCalibration, PlanarMotionFlagsRollPitchAndZAndHoldsThemAtTheInitia
   EXPECT_LT(e.time_ms, 1.0 * scale);
 }
 
+TEST(LidarPoseCalibration, AStationaryRecordingHoldsEveryParameterAtTheGuess) {
+  test::SyntheticOptions o;
+  o.duration_s = 1.0;
+  o.columns = 200;
+  o.selection.keep_points_ratio = 0.2;
+  const test::SyntheticRecording rec = test::makeSyntheticRecording(o);
+  const std::vector<Pose> still(rec.poses.size(), rec.poses.front());
+  const PoseTrajectory traj(rec.pose_stamps, still);
+  LidarPoseSettings s;
+  s.selection = o.selection;
+  s.initial_T_pose_lidar = fromXyzRpy({0.1, 0.2, 0.3, 0.01, 0.02, 0.03});
+  s.initial_time_offset_s = 0.005;
+  const LidarPoseResult r = calibrateLidarPose(rec.scans, traj, s);
+  for (std::size_t i = 0; i < kLidarPoseParams; ++i) {
+    EXPECT_TRUE(r.observability.poorly_constrained[i]) << i;
+    EXPECT_TRUE(r.held[i]) << i;
+  }
+  EXPECT_TRUE(r.T_pose_lidar.isApprox(s.initial_T_pose_lidar, 1e-12));
+  EXPECT_EQ(r.time_offset_s, 0.005);
+  EXPECT_EQ(r.global_status, "skipped");
+  EXPECT_EQ(r.local_status, "skipped");
+  EXPECT_EQ(r.final_cost, r.initial_cost);
+}
+
 TEST(LidarPoseCalibration, PosesNotCoveringTheLidarTimeRangeAreAClearError) {
   test::SyntheticOptions o;
   o.duration_s = 1.0;
