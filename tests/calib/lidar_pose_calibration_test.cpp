@@ -6,11 +6,12 @@
 
 #include "lidar_pose_synthetic.hpp"
 #include "rigcal/calib/lidar_pose_calibration.hpp"
+#include "sanitizers.hpp"
 
 namespace rigcal::calib {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if RIGCAL_SANITIZED
 constexpr bool kSanitized = true;
 #else
 constexpr bool kSanitized = false;

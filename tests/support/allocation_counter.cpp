@@ -4,13 +4,7 @@
 #include <cstdlib>
 #include <new>
 
-#if defined(__SANITIZE_THREAD__)
-#define RIGCAL_TSAN 1
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define RIGCAL_TSAN 1
-#endif
-#endif
+#include "sanitizers.hpp"
 
 namespace rigcal::test {
 namespace {
@@ -18,7 +12,7 @@ std::atomic<bool> g_counting{false};
 std::atomic<std::uint64_t> g_allocations{0};
 }  // namespace
 
-#ifdef RIGCAL_TSAN
+#if RIGCAL_TSAN
 bool AllocationCounter::available() { return false; }
 #else
 bool AllocationCounter::available() { return true; }
@@ -40,7 +34,7 @@ void countAllocation() {
 
 }  // namespace rigcal::test
 
-#ifndef RIGCAL_TSAN
+#if !RIGCAL_TSAN
 #if defined(__GNUC__) && !defined(__clang__)
 // GCC pairs the replaced operator new with free() after inlining and warns; they do match.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
