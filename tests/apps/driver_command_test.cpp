@@ -16,6 +16,9 @@
 namespace rigcal::test {
 namespace {
 
+// Generous: a sanitizer-instrumented driver on a loaded 2-core machine starts and decodes slowly.
+constexpr std::chrono::seconds kScanWait{30};
+
 class DriverCommand : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -60,7 +63,7 @@ TEST_F(DriverCommand, PublishesEveryScanIntactIntoItsRing) {
   std::vector<Scan> got;
   Scan scan;
   while (true) {
-    const auto status = r.read(scan, std::chrono::seconds(10));
+    const auto status = r.read(scan, kScanWait);
     if (status == shm::ReadStatus::kScan) got.push_back(scan);
     if (status != shm::ReadStatus::kScan) break;
   }
@@ -82,20 +85,20 @@ TEST_F(DriverCommand, KilledDriverIsReportedDeadAndARestartTakesOverItsRing) {
   Scan scan;
   {
     RigcalProcess first(driverArgs(pcap, "0.5"));  // ~1 s of capture at half speed
-    ASSERT_EQ(r.read(scan, std::chrono::seconds(10)), shm::ReadStatus::kScan);
+    ASSERT_EQ(r.read(scan, kScanWait), shm::ReadStatus::kScan);
     first.kill(SIGKILL);
     EXPECT_EQ(first.wait().exit_code, 128 + SIGKILL);
   }
   // Drain what the dead writer left, then the reader reports it gone.
   shm::ReadStatus status;
-  while ((status = r.read(scan, std::chrono::seconds(5))) == shm::ReadStatus::kScan) {
+  while ((status = r.read(scan, kScanWait)) == shm::ReadStatus::kScan) {
   }
   EXPECT_EQ(status, shm::ReadStatus::kWriterGone);
   const std::uint64_t first_epoch = r.epoch();
 
   RigcalProcess second(driverArgs(pcap, "max"));
   std::size_t scans_after_restart = 0;
-  while (r.read(scan, std::chrono::seconds(10)) == shm::ReadStatus::kScan) ++scans_after_restart;
+  while (r.read(scan, kScanWait) == shm::ReadStatus::kScan) ++scans_after_restart;
   const CommandResult result = second.wait();
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.out.find("took over a stale ring"), std::string::npos) << result.out;
