@@ -1,0 +1,261 @@
+#include "rigcal/sim/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rigcal::sim {
+namespace {
+
+void grow(Rect2& acc, const Rect2& r) {
+  acc.x0 = std::min(acc.x0, r.x0);
+  acc.y0 = std::min(acc.y0, r.y0);
+  acc.x1 = std::max(acc.x1, r.x1);
+  acc.y1 = std::max(acc.y1, r.y1);
+}
+
+bool insidePatch(const GroundPatch& p, double x, double y) {
+  const double px = x - p.cx, py = y - p.cy;
+  return std::abs(p.cos_yaw * px + p.sin_yaw * py) <= p.hx && std::abs(-p.sin_yaw * px + p.cos_yaw * py) <= p.hy;
+}
+
+std::vector<std::uint32_t> flatten(const std::vector<std::vector<std::uint32_t>>& cells,
+                                   std::vector<std::uint32_t>& start) {
+  start.assign(cells.size() + 1, 0);
+  std::vector<std::uint32_t> refs;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    start[c] = std::uint32_t(refs.size());
+    refs.insert(refs.end(), cells[c].begin(), cells[c].end());
+  }
+  start[cells.size()] = std::uint32_t(refs.size());
+  return refs;
+}
+
+}  // namespace
+
+Scene::Scene(SceneContent content, double cell_size) : content_(std::move(content)) {
+  if (!(cell_size > 0)) throw std::invalid_argument("scene grid cell size must be positive");
+  if (primitiveCount() >= (1u << 30)) throw std::invalid_argument("too many scene primitives");
+  cell_ = cell_size;
+  inv_cell_ = 1.0 / cell_size;
+  Rect2 b{0, 0, 0, 0};
+  bool any = false;
+  const auto take = [&](const Rect2& r) {
+    if (!any) b = r;
+    grow(b, r);
+    any = true;
+  };
+  for (const auto& x : content_.boxes) take(footprint(x));
+  for (const auto& x : content_.cylinders) take(footprint(x));
+  for (const auto& x : content_.ellipsoids) take(footprint(x));
+  for (const auto& x : content_.patches) take(footprint(x));
+  x0_ = std::floor(b.x0) - cell_;
+  y0_ = std::floor(b.y0) - cell_;
+  nx_ = std::max(1, int(std::ceil((b.x1 + cell_ - x0_) * inv_cell_)));
+  ny_ = std::max(1, int(std::ceil((b.y1 + cell_ - y0_) * inv_cell_)));
+
+  const std::size_t n = std::size_t(nx_) * std::size_t(ny_);
+  std::vector<std::vector<std::uint32_t>> cells(n), patch_cells(n);
+  std::vector<float> tops(n, -1e30f), unused(n);
+  for (std::uint32_t i = 0; i < content_.boxes.size(); ++i)
+    index(footprint(content_.boxes[i]), kBox | i, content_.boxes[i].z1, cells, tops);
+  for (std::uint32_t i = 0; i < content_.cylinders.size(); ++i)
+    index(footprint(content_.cylinders[i]), kCylinder | i, content_.cylinders[i].z1, cells, tops);
+  for (std::uint32_t i = 0; i < content_.ellipsoids.size(); ++i) {
+    const auto& e = content_.ellipsoids[i];
+    index(footprint(e), kEllipsoid | i, e.cz + e.rz, cells, tops);
+  }
+  for (std::uint32_t i = 0; i < content_.patches.size(); ++i)
+    index(footprint(content_.patches[i]), i, 0, patch_cells, unused);
+  refs_ = flatten(cells, start_);
+  patch_refs_ = flatten(patch_cells, patch_start_);
+  cell_top_ = std::move(tops);
+  computeEmptySpace();
+  top_ = -1e30;
+  for (float t : cell_top_) top_ = std::max(top_, double(t));
+}
+
+bool Scene::cellRange(const Rect2& r, int& i0, int& j0, int& i1, int& j1) const {
+  i0 = std::max(0, int(std::floor((r.x0 - x0_) * inv_cell_)));
+  j0 = std::max(0, int(std::floor((r.y0 - y0_) * inv_cell_)));
+  i1 = std::min(nx_ - 1, int(std::floor((r.x1 - x0_) * inv_cell_)));
+  j1 = std::min(ny_ - 1, int(std::floor((r.y1 - y0_) * inv_cell_)));
+  return i0 <= i1 && j0 <= j1;
+}
+
+void Scene::index(const Rect2& r, std::uint32_t ref, double top, std::vector<std::vector<std::uint32_t>>& cells,
+                  std::vector<float>& tops) const {
+  int i0, j0, i1, j1;
+  if (!cellRange(r, i0, j0, i1, j1)) return;
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      const std::size_t c = std::size_t(j) * std::size_t(nx_) + std::size_t(i);
+      cells[c].push_back(ref);
+      // Rounded up so a float top never cuts off a primitive's true top.
+      tops[c] = std::max(tops[c], std::nextafter(float(top), 1e30f));
+    }
+}
+
+Material Scene::groundMaterial(double x, double y) const {
+  const int i = int(std::floor((x - x0_) * inv_cell_)), j = int(std::floor((y - y0_) * inv_cell_));
+  if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return Material::kAsphalt;
+  const std::size_t c = std::size_t(j) * std::size_t(nx_) + std::size_t(i);
+  // The last listed patch wins: markings are added after the surfaces they are painted on.
+  Material m = Material::kAsphalt;
+  for (std::uint32_t k = patch_start_[c]; k < patch_start_[c + 1]; ++k) {
+    const GroundPatch& p = content_.patches[patch_refs_[k]];
+    if (insidePatch(p, x, y)) m = p.material;
+  }
+  return m;
+}
+
+bool Scene::cast(const Ray& ray, double t_min, double t_max, Hit& hit) const {
+  Hit best;
+  best.t = t_max;
+  const bool ground = content_.ground.intersect(ray, t_min, best);
+  const double ground_t = ground ? best.t : -1.0;
+  bool found = ground;
+
+  // Clip the ray's ground-plane projection to the grid, then walk the cells it crosses (DDA).
+  const double ox = ray.origin.x(), oy = ray.origin.y(), oz = ray.origin.z();
+  const double dx = ray.dir.x(), dy = ray.dir.y(), dz = ray.dir.z();
+  const double gx1 = x0_ + nx_ * cell_, gy1 = y0_ + ny_ * cell_;
+  double t0 = t_min, t1 = best.t;
+  const auto clip = [&](double o, double d, double lo, double hi) {
+    if (d == 0) {
+      if (o < lo || o > hi) t1 = -1;
+      return;
+    }
+    double a = (lo - o) / d, b = (hi - o) / d;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+  };
+  clip(ox, dx, x0_, gx1);
+  clip(oy, dy, y0_, gy1);
+  if (t0 < t1) {
+    const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
+    const double inf = std::numeric_limits<double>::infinity();
+    const double delta_x = dx != 0 ? cell_ / std::abs(dx) : inf;
+    const double delta_y = dy != 0 ? cell_ / std::abs(dy) : inf;
+    const double inv_horizontal = 1.0 / std::max(std::hypot(dx, dy), 1e-12);
+    int ix = 0, iy = 0;
+    double t_next_x = inf, t_next_y = inf, t_in = t0;
+    // (Re)starts the walk at parameter t: the cell holding the point, and where the ray leaves it.
+    const auto enter = [&](double t) {
+      t_in = t;
+      ix = std::clamp(int(std::floor((ox + t * dx - x0_) * inv_cell_)), 0, nx_ - 1);
+      iy = std::clamp(int(std::floor((oy + t * dy - y0_) * inv_cell_)), 0, ny_ - 1);
+      t_next_x = dx > 0 ? (x0_ + (ix + 1) * cell_ - ox) / dx : dx < 0 ? (x0_ + ix * cell_ - ox) / dx : inf;
+      t_next_y = dy > 0 ? (y0_ + (iy + 1) * cell_ - oy) / dy : dy < 0 ? (y0_ + iy * cell_ - oy) / dy : inf;
+    };
+    enter(t0);
+    for (;;) {
+      const double z_in = oz + t_in * dz;
+      if (dz > 0 && z_in > top_) break;  // rising above everything
+      const std::size_t c = std::size_t(iy) * std::size_t(nx_) + std::size_t(ix);
+      const std::uint32_t begin = start_[c], end = start_[c + 1];
+      if (begin == end && empty_[c] >= 2) {
+        // Every cell within Chebyshev distance empty_[c] − 1 is empty: jump across them at once.
+        const double t_jump = t_in + (empty_[c] - 1) * cell_ * inv_horizontal;
+        if (t_jump >= t1) break;
+        enter(t_jump);
+        continue;
+      }
+      const double t_out = std::min({t_next_x, t_next_y, t1});
+      if (begin != end && std::min(z_in, oz + t_out * dz) <= cell_top_[c]) {
+        for (std::uint32_t k = begin; k < end; ++k) {
+          const std::uint32_t ref = refs_[k], idx = ref & ~kTypeMask;
+          switch (ref & kTypeMask) {
+            case kBox: found |= intersect(content_.boxes[idx], ray, t_min, best); break;
+            case kCylinder: found |= intersect(content_.cylinders[idx], ray, t_min, best); break;
+            default: found |= intersect(content_.ellipsoids[idx], ray, t_min, best); break;
+          }
+        }
+      }
+      if (best.t <= t_out || t_out >= t1) break;
+      if (t_next_x < t_next_y) {
+        ix += step_x;
+        t_in = t_next_x;
+        t_next_x += delta_x;
+        if (ix < 0 || ix >= nx_) break;
+      } else {
+        iy += step_y;
+        t_in = t_next_y;
+        t_next_y += delta_y;
+        if (iy < 0 || iy >= ny_) break;
+      }
+    }
+  }
+  if (!found) return false;
+  if (ground && best.t == ground_t) {
+    const Eigen::Vector3d p = ray.origin + best.t * ray.dir;
+    best.material = groundMaterial(p.x(), p.y());
+  }
+  hit = best;
+  return true;
+}
+
+double Scene::surfaceDistance(const Eigen::Vector3d& p, double radius) const {
+  double gx = 0, gy = 0;
+  const double h = content_.ground.height(p.x(), p.y(), gx, gy);
+  double best = std::abs(p.z() - h) / std::sqrt(1 + gx * gx + gy * gy);
+  int i0, j0, i1, j1;
+  if (!cellRange({p.x() - radius, p.y() - radius, p.x() + radius, p.y() + radius}, i0, j0, i1, j1)) return best;
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      const std::size_t c = std::size_t(j) * std::size_t(nx_) + std::size_t(i);
+      for (std::uint32_t k = start_[c]; k < start_[c + 1]; ++k) {
+        const std::uint32_t ref = refs_[k], idx = ref & ~kTypeMask;
+        double d = 0;
+        switch (ref & kTypeMask) {
+          case kBox: d = sim::surfaceDistance(content_.boxes[idx], p); break;
+          case kCylinder: d = sim::surfaceDistance(content_.cylinders[idx], p); break;
+          default: d = sim::surfaceDistance(content_.ellipsoids[idx], p); break;
+        }
+        best = std::min(best, d);
+      }
+    }
+  return best;
+}
+
+void Scene::computeEmptySpace() {
+  // Chebyshev distance (in cells, capped) from each cell to the nearest occupied one: two passes of
+  // the classic chamfer transform with the 8-neighbourhood.
+  const std::size_t n = std::size_t(nx_) * std::size_t(ny_);
+  std::vector<int> d(n);
+  for (std::size_t c = 0; c < n; ++c) d[c] = start_[c] != start_[c + 1] ? 0 : 1 << 20;
+  const auto at = [&](int i, int j) -> int& { return d[std::size_t(j) * std::size_t(nx_) + std::size_t(i)]; };
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) {
+      int& v = at(i, j);
+      if (i > 0) v = std::min(v, at(i - 1, j) + 1);
+      if (j > 0) {
+        v = std::min(v, at(i, j - 1) + 1);
+        if (i > 0) v = std::min(v, at(i - 1, j - 1) + 1);
+        if (i + 1 < nx_) v = std::min(v, at(i + 1, j - 1) + 1);
+      }
+    }
+  for (int j = ny_ - 1; j >= 0; --j)
+    for (int i = nx_ - 1; i >= 0; --i) {
+      int& v = at(i, j);
+      if (i + 1 < nx_) v = std::min(v, at(i + 1, j) + 1);
+      if (j + 1 < ny_) {
+        v = std::min(v, at(i, j + 1) + 1);
+        if (i + 1 < nx_) v = std::min(v, at(i + 1, j + 1) + 1);
+        if (i > 0) v = std::min(v, at(i - 1, j + 1) + 1);
+      }
+    }
+  // Outside the grid there is nothing, so the distance to the border does not limit a jump; the
+  // walk stops at the border anyway.
+  empty_.resize(n);
+  for (std::size_t c = 0; c < n; ++c) empty_[c] = std::uint8_t(std::min(d[c], 255));
+}
+
+double Scene::meanRefsPerOccupiedCell() const {
+  std::size_t occupied = 0;
+  for (std::size_t c = 0; c + 1 < start_.size(); ++c) occupied += start_[c + 1] != start_[c];
+  return occupied ? double(refs_.size()) / double(occupied) : 0.0;
+}
+
+}  // namespace rigcal::sim
