@@ -15,5 +15,6 @@ struct CommandFailed : std::runtime_error {
 };
 
 void addCheckConfigCommand(CLI::App& app);
+void addSimCommand(CLI::App& app);
 
 }  // namespace rigcal::app

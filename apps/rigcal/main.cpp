@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   app.footer(kExitCodesHelp);
 
   addCheckConfigCommand(app);
+  addSimCommand(app);
 
   try {
     app.parse(argc, argv);

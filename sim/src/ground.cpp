@@ -18,6 +18,21 @@ Ground::Ground(const GroundSpec& spec, std::uint64_t seed) : spec_(spec) {
                        std::abs(lattice(i, j + 1) - lattice(i, j))});
     }
   max_bump_ = hi;
+  // The quadratic B-spline over lattice cell (i, j) is a biquadratic polynomial in the cell's local
+  // coordinates: precompute its 9 coefficients. Lattice point k sits at (k + 0.5)·spacing, so the
+  // cell blends points i − 1, i, i + 1 with the basis ((1−a)²/2, 1/2 + a − a², a²/2).
+  static constexpr double kBasis[3][3] = {{0.5, -1.0, 0.5}, {0.5, 1.0, -1.0}, {0.0, 0.0, 0.5}};
+  poly_.assign(std::size_t(kLattice) * kLattice * 9, 0.0);
+  for (int j = 0; j < kLattice; ++j)
+    for (int i = 0; i < kLattice; ++i) {
+      double* c = &poly_[std::size_t((j * kLattice + i) * 9)];
+      for (int r = 0; r < 3; ++r)
+        for (int q = 0; q < 3; ++q) {
+          const double l = lattice(i - 1 + q, j - 1 + r);
+          for (int k = 0; k < 3; ++k)
+            for (int m = 0; m < 3; ++m) c[3 * k + m] += kBasis[q][k] * kBasis[r][m] * l;
+        }
+    }
   // ∂B/∂x is a convex combination of neighbour differences / spacing, likewise ∂B/∂y; along a unit
   // horizontal direction the derivative is bounded by √2 times that.
   max_gradient_ = std::sqrt(2.0) * diff * inv_spacing_;
@@ -28,33 +43,21 @@ double Ground::bumps(double x, double y, double* gx, double* gy) const {
     if (gx) *gx = *gy = 0;
     return 0;
   }
-  // Quadratic B-spline: lattice point k sits at (k + 0.5)·spacing, so cell i covers the
-  // influence of points i − 1, i, i + 1.
   const double u = x * inv_spacing_, v = y * inv_spacing_;
-  const double fu = std::floor(u), fv = std::floor(v);
-  const int i = int(fu), j = int(fv);
-  const double a = u - fu, b = v - fv;
-  const double wu[3] = {0.5 * (1 - a) * (1 - a), 0.5 + a * (1 - a), 0.5 * a * a};
-  const double wv[3] = {0.5 * (1 - b) * (1 - b), 0.5 + b * (1 - b), 0.5 * b * b};
-  const double du[3] = {-(1 - a), 1 - 2 * a, a};
-  const double dv[3] = {-(1 - b), 1 - 2 * b, b};
-  double h = 0, hx = 0, hy = 0;
-  for (int r = 0; r < 3; ++r) {
-    double row = 0, row_dx = 0;
-    for (int c = 0; c < 3; ++c) {
-      const double l = lattice(i - 1 + c, j - 1 + r);
-      row += wu[c] * l;
-      row_dx += du[c] * l;
-    }
-    h += wv[r] * row;
-    hx += wv[r] * row_dx;
-    hy += dv[r] * row;
-  }
+  // floor without a libm call (no SSE4.1 in the baseline ISA); |u|, |v| are far inside int range.
+  int i = int(u), j = int(v);
+  i -= u < double(i);
+  j -= v < double(j);
+  const double a = u - i, b = v - j;
+  const double* c = &poly_[std::size_t(((j & (kLattice - 1)) * kLattice + (i & (kLattice - 1))) * 9)];
+  // c[3k + m] multiplies a^k·b^m.
+  const double r0 = c[0] + b * (c[1] + b * c[2]), r1 = c[3] + b * (c[4] + b * c[5]), r2 = c[6] + b * (c[7] + b * c[8]);
   if (gx) {
-    *gx = hx * inv_spacing_;
-    *gy = hy * inv_spacing_;
+    const double s0 = c[1] + 2 * b * c[2], s1 = c[4] + 2 * b * c[5], s2 = c[7] + 2 * b * c[8];
+    *gx = (r1 + 2 * a * r2) * inv_spacing_;
+    *gy = (s0 + a * (s1 + a * s2)) * inv_spacing_;
   }
-  return h;
+  return r0 + a * (r1 + a * r2);
 }
 
 double Ground::height(double x, double y) const {
@@ -96,10 +99,10 @@ bool Ground::intersect(const Ray& ray, double t_min, Hit& hit) const {
   if (p1 >= 0) return false;  // level or rising against the plane: stays clear of the ground
   const double band_in = (p0 - max_bump_) / -p1, band_out = (p0 + max_bump_) / -p1;
   double lo = std::max(t_min, band_in), hi = std::min(hit.t, band_out);
-  if (lo >= hi) return false;
+  if (lo > hi) return false;  // equal on a bump-free ground: the plane crossing itself
   // Above the band the clearance is ≥ 0 and below it ≤ 0; only cut ends need checking.
   if (lo > band_in && clearance(ray, lo, nullptr) <= 0) return false;  // t_min inside the ground
-  const double horizontal = std::hypot(d.x(), d.y());
+  const double horizontal = std::sqrt(d.x() * d.x() + d.y() * d.y());
   if (-p1 <= max_gradient_ * horizontal * 1.01) {
     // Grazing ray: the clearance may not be monotonic. March in steps short against the bump scale
     // until it changes sign, and bracket the first crossing.

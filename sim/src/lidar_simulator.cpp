@@ -35,11 +35,18 @@ void LidarSimulator::cast(FiringBatch& batch, std::size_t begin, std::size_t end
   const std::size_t nb = beams_.size();
   const double n_radius = m.beam_origin_radius_m;
   const double unit = m.distance_unit_m;
+  // Poses at each sequence's start and end; each beam's pose is interpolated at its own firing time
+  // (exact to second order over ~50 µs: far below a micrometre). A sequence's end is the next one's
+  // start, so each pose is computed once.
+  Pose T1 = Pose::Identity();
+  TimeNs t1 = -1;
   for (std::size_t f = begin; f < end; ++f) {
     const SimFiring& firing = batch.firings[f];
-    // Poses at the sequence start and end; each beam's pose is interpolated at its own firing time
-    // (exact to second order over ~50 µs: far below a micrometre).
-    const Pose T0 = sensorPose(firing.true_time_ns), T1 = sensorPose(firing.true_time_ns + period_ns_);
+    const Pose T0 = t1 == firing.true_time_ns ? T1 : sensorPose(firing.true_time_ns);
+    const bool next_adjacent = f + 1 < batch.size() && batch.firings[f + 1].sequence == firing.sequence + 1;
+    t1 = next_adjacent ? batch.firings[f + 1].true_time_ns : firing.true_time_ns + period_ns_;
+    T1 = sensorPose(t1);
+    const double inv_span = double(period_ns_) / double(t1 - firing.true_time_ns);
     const double a = deg2rad(firing.rotor_azimuth_deg), ca = std::cos(a), sa = std::sin(a);
     const Eigen::Vector3d origin_s = m.beamOrigin(firing.rotor_azimuth_deg);
     const Eigen::Vector3d o0 = T0 * origin_s, o1 = T1 * origin_s;
@@ -51,7 +58,7 @@ void LidarSimulator::cast(FiringBatch& batch, std::size_t begin, std::size_t end
       // Sensor-frame direction: rotor azimuth plus the beam's offset (angle addition), elevation.
       const double cos_a = ca * bt.cos_az - sa * bt.sin_az, sin_a = sa * bt.cos_az + ca * bt.sin_az;
       const Eigen::Vector3d d_s(bt.cos_el * cos_a, -bt.cos_el * sin_a, bt.sin_el);
-      const double u = bt.time_fraction;
+      const double u = bt.time_fraction * inv_span;
       Ray ray;
       ray.origin = o0 + u * (o1 - o0);
       ray.dir = ((1 - u) * (T0.linear() * d_s) + u * (T1.linear() * d_s)).normalized();
@@ -68,7 +75,8 @@ void LidarSimulator::cast(FiringBatch& batch, std::size_t begin, std::size_t end
       const double reach = m.max_range_m * std::clamp(std::sqrt(rho / 0.5), 0.35, 1.0);
       double range = hit.t + n_radius;
       if (range > reach) continue;
-      if (unitFromBits(mix64(h ^ 0x1)) < noise_.dropout + mat.dropout) continue;
+      // Random losses and the material's own (glass, foliage) are independent causes.
+      if (unitFromBits(mix64(h ^ 0x1)) < noise_.dropout || unitFromBits(mix64(h ^ 0x4)) < mat.dropout) continue;
       // One Box–Muller pair: cosine branch for range, sine branch for intensity.
       const double u1 = 1.0 - unitFromBits(mix64(h ^ 0x2)), u2 = unitFromBits(mix64(h ^ 0x3));
       const double radius = std::sqrt(-2.0 * std::log(u1));

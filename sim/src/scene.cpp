@@ -14,6 +14,12 @@ void grow(Rect2& acc, const Rect2& r) {
   acc.y1 = std::max(acc.y1, r.y1);
 }
 
+// floor() for values well inside int range; std::floor is a libm call without SSE4.1.
+inline int fastFloor(double v) {
+  const int i = int(v);
+  return i - (v < double(i));
+}
+
 bool insidePatch(const GroundPatch& p, double x, double y) {
   const double px = x - p.cx, py = y - p.cy;
   return std::abs(p.cos_yaw * px + p.sin_yaw * py) <= p.hx && std::abs(-p.sin_yaw * px + p.cos_yaw * py) <= p.hy;
@@ -70,7 +76,6 @@ Scene::Scene(SceneContent content, double cell_size) : content_(std::move(conten
   refs_ = flatten(cells, start_);
   patch_refs_ = flatten(patch_cells, patch_start_);
   cell_top_ = std::move(tops);
-  computeEmptySpace();
   top_ = -1e30;
   for (float t : cell_top_) top_ = std::max(top_, double(t));
 }
@@ -97,7 +102,7 @@ void Scene::index(const Rect2& r, std::uint32_t ref, double top, std::vector<std
 }
 
 Material Scene::groundMaterial(double x, double y) const {
-  const int i = int(std::floor((x - x0_) * inv_cell_)), j = int(std::floor((y - y0_) * inv_cell_));
+  const int i = fastFloor((x - x0_) * inv_cell_), j = fastFloor((y - y0_) * inv_cell_);
   if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return Material::kAsphalt;
   const std::size_t c = std::size_t(j) * std::size_t(nx_) + std::size_t(i);
   // The last listed patch wins: markings are added after the surfaces they are painted on.
@@ -133,43 +138,53 @@ bool Scene::cast(const Ray& ray, double t_min, double t_max, Hit& hit) const {
   };
   clip(ox, dx, x0_, gx1);
   clip(oy, dy, y0_, gy1);
+  // Rising rays end where they clear the tallest primitive.
+  if (dz > 0) t1 = std::min(t1, (top_ - oz) / dz);
   if (t0 < t1) {
+    // Per-thread mailbox: a primitive spanning several cells is tested once per ray.
+    thread_local std::vector<std::uint32_t> tested;
+    thread_local std::uint32_t ray_id = 0;
+    const std::size_t prims = primitiveCount();
+    if (tested.size() < prims) tested.resize(prims, 0);
+    if (++ray_id == 0) {
+      std::fill(tested.begin(), tested.end(), 0);
+      ray_id = 1;
+    }
+    const std::uint32_t box_base = 0, cyl_base = std::uint32_t(content_.boxes.size()),
+                        ell_base = cyl_base + std::uint32_t(content_.cylinders.size());
+
+    int ix = std::clamp(fastFloor((ox + t0 * dx - x0_) * inv_cell_), 0, nx_ - 1);
+    int iy = std::clamp(fastFloor((oy + t0 * dy - y0_) * inv_cell_), 0, ny_ - 1);
     const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
     const double inf = std::numeric_limits<double>::infinity();
+    double t_next_x = dx > 0 ? (x0_ + (ix + 1) * cell_ - ox) / dx : dx < 0 ? (x0_ + ix * cell_ - ox) / dx : inf;
+    double t_next_y = dy > 0 ? (y0_ + (iy + 1) * cell_ - oy) / dy : dy < 0 ? (y0_ + iy * cell_ - oy) / dy : inf;
     const double delta_x = dx != 0 ? cell_ / std::abs(dx) : inf;
     const double delta_y = dy != 0 ? cell_ / std::abs(dy) : inf;
-    const double inv_horizontal = 1.0 / std::max(std::hypot(dx, dy), 1e-12);
-    int ix = 0, iy = 0;
-    double t_next_x = inf, t_next_y = inf, t_in = t0;
-    // (Re)starts the walk at parameter t: the cell holding the point, and where the ray leaves it.
-    const auto enter = [&](double t) {
-      t_in = t;
-      ix = std::clamp(int(std::floor((ox + t * dx - x0_) * inv_cell_)), 0, nx_ - 1);
-      iy = std::clamp(int(std::floor((oy + t * dy - y0_) * inv_cell_)), 0, ny_ - 1);
-      t_next_x = dx > 0 ? (x0_ + (ix + 1) * cell_ - ox) / dx : dx < 0 ? (x0_ + ix * cell_ - ox) / dx : inf;
-      t_next_y = dy > 0 ? (y0_ + (iy + 1) * cell_ - oy) / dy : dy < 0 ? (y0_ + iy * cell_ - oy) / dy : inf;
-    };
-    enter(t0);
+    double t_in = t0;
     for (;;) {
-      const double z_in = oz + t_in * dz;
-      if (dz > 0 && z_in > top_) break;  // rising above everything
+      const double t_out = std::min({t_next_x, t_next_y, t1});
       const std::size_t c = std::size_t(iy) * std::size_t(nx_) + std::size_t(ix);
       const std::uint32_t begin = start_[c], end = start_[c + 1];
-      if (begin == end && empty_[c] >= 2) {
-        // Every cell within Chebyshev distance empty_[c] − 1 is empty: jump across them at once.
-        const double t_jump = t_in + (empty_[c] - 1) * cell_ * inv_horizontal;
-        if (t_jump >= t1) break;
-        enter(t_jump);
-        continue;
-      }
-      const double t_out = std::min({t_next_x, t_next_y, t1});
-      if (begin != end && std::min(z_in, oz + t_out * dz) <= cell_top_[c]) {
+      if (begin != end && std::min(oz + t_in * dz, oz + t_out * dz) <= cell_top_[c]) {
         for (std::uint32_t k = begin; k < end; ++k) {
           const std::uint32_t ref = refs_[k], idx = ref & ~kTypeMask;
           switch (ref & kTypeMask) {
-            case kBox: found |= intersect(content_.boxes[idx], ray, t_min, best); break;
-            case kCylinder: found |= intersect(content_.cylinders[idx], ray, t_min, best); break;
-            default: found |= intersect(content_.ellipsoids[idx], ray, t_min, best); break;
+            case kBox:
+              if (tested[box_base + idx] == ray_id) break;
+              tested[box_base + idx] = ray_id;
+              found |= intersect(content_.boxes[idx], ray, t_min, best);
+              break;
+            case kCylinder:
+              if (tested[cyl_base + idx] == ray_id) break;
+              tested[cyl_base + idx] = ray_id;
+              found |= intersect(content_.cylinders[idx], ray, t_min, best);
+              break;
+            default:
+              if (tested[ell_base + idx] == ray_id) break;
+              tested[ell_base + idx] = ray_id;
+              found |= intersect(content_.ellipsoids[idx], ray, t_min, best);
+              break;
           }
         }
       }
@@ -217,39 +232,6 @@ double Scene::surfaceDistance(const Eigen::Vector3d& p, double radius) const {
       }
     }
   return best;
-}
-
-void Scene::computeEmptySpace() {
-  // Chebyshev distance (in cells, capped) from each cell to the nearest occupied one: two passes of
-  // the classic chamfer transform with the 8-neighbourhood.
-  const std::size_t n = std::size_t(nx_) * std::size_t(ny_);
-  std::vector<int> d(n);
-  for (std::size_t c = 0; c < n; ++c) d[c] = start_[c] != start_[c + 1] ? 0 : 1 << 20;
-  const auto at = [&](int i, int j) -> int& { return d[std::size_t(j) * std::size_t(nx_) + std::size_t(i)]; };
-  for (int j = 0; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) {
-      int& v = at(i, j);
-      if (i > 0) v = std::min(v, at(i - 1, j) + 1);
-      if (j > 0) {
-        v = std::min(v, at(i, j - 1) + 1);
-        if (i > 0) v = std::min(v, at(i - 1, j - 1) + 1);
-        if (i + 1 < nx_) v = std::min(v, at(i + 1, j - 1) + 1);
-      }
-    }
-  for (int j = ny_ - 1; j >= 0; --j)
-    for (int i = nx_ - 1; i >= 0; --i) {
-      int& v = at(i, j);
-      if (i + 1 < nx_) v = std::min(v, at(i + 1, j) + 1);
-      if (j + 1 < ny_) {
-        v = std::min(v, at(i, j + 1) + 1);
-        if (i + 1 < nx_) v = std::min(v, at(i + 1, j + 1) + 1);
-        if (i > 0) v = std::min(v, at(i - 1, j + 1) + 1);
-      }
-    }
-  // Outside the grid there is nothing, so the distance to the border does not limit a jump; the
-  // walk stops at the border anyway.
-  empty_.resize(n);
-  for (std::size_t c = 0; c < n; ++c) empty_[c] = std::uint8_t(std::min(d[c], 255));
 }
 
 double Scene::meanRefsPerOccupiedCell() const {

@@ -99,6 +99,7 @@ SimulationStats Simulation::run(SimulationSink& sink, const SimulationOptions& o
       sink.onFirings(i, batches[i]);
       if (options.build_scans) sweeps[i].add(batches[i]);
     }
+    sink.onChunkEnd(chunk_end);
   }
   for (auto& s : sweeps) s.flush();
   stats.total_seconds = secondsSince(t_start);

@@ -45,6 +45,7 @@ class Ground {
 
   GroundSpec spec_;
   std::vector<double> heights_;
+  std::vector<double> poly_;  // per lattice cell: 9 coefficients of its biquadratic patch
   double inv_spacing_ = 0.2;
   double max_bump_ = 0;       // bound on |bumps|
   double max_gradient_ = 0;   // bound on |∇bumps| along any unit horizontal direction

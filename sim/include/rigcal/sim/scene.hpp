@@ -48,7 +48,6 @@ class Scene {
              std::vector<float>& tops) const;
   [[nodiscard]] bool cellRange(const Rect2& r, int& i0, int& j0, int& i1, int& j1) const;
   [[nodiscard]] Material groundMaterial(double x, double y) const;
-  void computeEmptySpace();
 
   SceneContent content_;
   double cell_ = 2.0, inv_cell_ = 0.5;
@@ -58,7 +57,6 @@ class Scene {
   // Compressed cell lists: refs_[start_[c] .. start_[c + 1]) for cell c; patch lists likewise.
   std::vector<std::uint32_t> start_, refs_, patch_start_, patch_refs_;
   std::vector<float> cell_top_;
-  std::vector<std::uint8_t> empty_;  // Chebyshev distance to the nearest occupied cell (capped)
 };
 
 }  // namespace rigcal::sim

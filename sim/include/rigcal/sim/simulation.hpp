@@ -30,6 +30,8 @@ class SimulationSink {
   virtual ~SimulationSink() = default;
   virtual void onFirings(std::size_t /*sensor*/, const FiringBatch& /*batch*/) {}
   virtual void onScan(SimulatedScan&& /*scan*/) {}
+  /// Every sensor's firings before `true_time` have been delivered.
+  virtual void onChunkEnd(TimeNs /*true_time*/) {}
 };
 
 struct SimulationStats {
