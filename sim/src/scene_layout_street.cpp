@@ -60,19 +60,33 @@ void sideOfStreet(const CentreLine& line, double side, double curb, double cross
                   Placer& place, Rng& rng) {
   const double total = line.length();
   const auto off = [&](double s, double d) { return Eigen::Vector2d(line.at(s) + side * d * line.left(s)); };
+  // The frontage first (the biggest things): buildings set back behind the sidewalk, with alleys
+  // between some of them.
+  for (double s = rng.uniform(0, 5); s < total;) {
+    const double len = rng.uniform(10, 28), depth = rng.uniform(9, 16);
+    const double d = curb + rng.uniform(3.5, 5.5) + 0.5 * depth;
+    const double mid = s + 0.5 * len;
+    if (std::abs(mid - crossing) > 0.5 * len + 8) {
+      const Eigen::Vector2d c = off(mid, d);
+      const double yaw = line.yaw(mid) + (side > 0 ? M_PI : 0);  // front faces the street
+      if (place.free(rotatedRect(c, yaw, len, depth), 0.2))
+        place.occupy(build.building(c, yaw, len, depth, int(rng.uniformInt(2, 5)), rng.chance(0.3)));
+    }
+    s += len + (rng.chance(0.4) ? rng.uniform(3, 7) : 0.6);
+  }
+  // Parked cars in the parking lane.
+  for (double s = rng.uniform(1, 6); s < total - 3; s += rng.uniform(5.6, 8.5)) {
+    if (std::abs(s - crossing) < 12 || !rng.chance(0.55)) continue;
+    const Eigen::Vector2d c = off(s, curb - rng.uniform(1.2, 1.4));
+    const double yaw = line.yaw(s) + (side > 0 ? 0.0 : M_PI) + rng.uniform(-0.04, 0.04);
+    if (place.free(rotatedRect(c, yaw, 4.9, 1.9), 0.1)) place.occupy(build.car(c, yaw));
+  }
   // Curb stones, interrupted at the crossing.
   for (double s = 0; s + 3 <= total; s += 3) {
     if (std::abs(s - crossing) < 8) continue;
     const Eigen::Vector2d a = off(s, curb), b = off(s + 3, curb);
     const Rect2 r{std::min(a.x(), b.x()), std::min(a.y(), b.y()), std::max(a.x(), b.x()), std::max(a.y(), b.y())};
     if (place.free(r, -0.05)) place.occupy(build.curb(a, b));
-  }
-  // Parked cars in the parking lane.
-  for (double s = rng.uniform(1, 6); s < total - 3; s += rng.uniform(5.6, 8.5)) {
-    if (std::abs(s - crossing) < 12 || !rng.chance(0.55)) continue;
-    const Eigen::Vector2d c = off(s, curb - rng.uniform(1.05, 1.3));
-    const double yaw = line.yaw(s) + (side > 0 ? 0.0 : M_PI) + rng.uniform(-0.04, 0.04);
-    if (place.free(rotatedRect(c, yaw, 4.9, 1.9), 0.1)) place.occupy(build.car(c, yaw));
   }
   // Sidewalk furniture: trees, light poles, signs, bollards.
   for (double s = rng.uniform(2, 8); s < total; s += rng.uniform(8, 14)) {
@@ -92,20 +106,6 @@ void sideOfStreet(const CentreLine& line, double side, double curb, double cross
       const Eigen::Vector2d p = off(s + (s < crossing ? -1.5 * k : 1.5 * k), curb + 0.4);
       if (place.free(around(p, 0.2), 0.05)) place.occupy(build.bollard(p));
     }
-  // The frontage: buildings set back behind the sidewalk, with alleys between some of them.
-  double s = rng.uniform(0, 5);
-  while (s < total) {
-    const double len = rng.uniform(10, 28), depth = rng.uniform(9, 16);
-    const double d = curb + rng.uniform(3.5, 5.5) + 0.5 * depth;
-    const double mid = s + 0.5 * len;
-    if (std::abs(mid - crossing) > 0.5 * len + 8) {
-      const Eigen::Vector2d c = off(mid, d);
-      const double yaw = line.yaw(mid) + (side > 0 ? M_PI : 0);  // front faces the street
-      if (place.free(rotatedRect(c, yaw, len, depth), 0.2))
-        place.occupy(build.building(c, yaw, len, depth, int(rng.uniformInt(2, 5)), rng.chance(0.3)));
-    }
-    s += len + (rng.chance(0.4) ? rng.uniform(3, 7) : 0.6);
-  }
 }
 
 }  // namespace
