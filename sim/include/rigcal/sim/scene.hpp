@@ -48,6 +48,9 @@ class Scene {
              std::vector<float>& tops) const;
   [[nodiscard]] bool cellRange(const Rect2& r, int& i0, int& j0, int& i1, int& j1) const;
   [[nodiscard]] Material groundMaterial(double x, double y) const;
+  /// Tests the primitives of the cells the ray crosses in [t_in, t_out]; true if any was hit.
+  bool walkCells(const Ray& ray, double t_in, double t_out, double t_min, Hit& best, std::uint32_t* tested,
+                 std::uint32_t ray_id) const;
 
   SceneContent content_;
   double cell_ = 2.0, inv_cell_ = 0.5;
