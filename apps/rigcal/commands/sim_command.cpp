@@ -14,8 +14,7 @@
 #include "rigcal/core/pcd_io.hpp"
 #include "rigcal/core/point_table.hpp"
 #include "rigcal/sim/outputs.hpp"
-#include "rigcal/sim/packet_encoder.hpp"
-#include "rigcal/sim/recording_writer.hpp"
+#include "rigcal/sim/recording.hpp"
 #include "rigcal/sim/simulation.hpp"
 
 namespace rigcal::app {
@@ -32,68 +31,25 @@ struct SimArgs {
   int threads = 2;
 };
 
-// Encodes every sensor's firings into the capture and/or dumps sweeps, as the run produces them.
-class OutputSink : public sim::SimulationSink {
+// Writes every simulated sweep as a PCD file under DIR/scans/<sensor>/.
+class ScanDumper : public sim::SimulationSink {
  public:
-  OutputSink(const sim::Simulation& s, std::vector<std::unique_ptr<sim::PacketEncoder>> encoders,
-             std::unique_ptr<sim::RecordingWriter> recording, std::optional<fs::path> scans_dir)
-      : sim_(s), encoders_(std::move(encoders)), recording_(std::move(recording)), scans_dir_(std::move(scans_dir)) {}
-
-  void onFirings(std::size_t sensor, const sim::FiringBatch& batch) override {
-    if (!recording_) return;
-    encoders_[sensor]->add(batch, packets_);
-    recording_->add(sensor, packets_);
-  }
-  void onChunkEnd(TimeNs true_time) override {
-    // Packets still to come carry a firing from a later chunk, so they are sent after true_time.
-    if (recording_) recording_->flushUntil(true_time);
-  }
+  ScanDumper(const sim::Simulation& s, fs::path dir) : sim_(s), dir_(std::move(dir)) {}
   void onScan(sim::SimulatedScan&& scan) override {
-    if (!scans_dir_) return;
-    const fs::path dir = *scans_dir_ / sim_.scenario().sensors[scan.sensor].name;
+    const fs::path dir = dir_ / sim_.scenario().sensors[scan.sensor].name;
     fs::create_directories(dir);
     char name[32];
     std::snprintf(name, sizeof name, "%06llu.pcd", static_cast<unsigned long long>(scan.scan.sequence));
     writePcd(dir / name, toTable(scan.scan));
     ++dumped_;
   }
-  void finish() {
-    if (!recording_) return;
-    for (std::size_t i = 0; i < encoders_.size(); ++i) {
-      encoders_[i]->finish(packets_);
-      recording_->add(i, packets_);
-    }
-    recording_->finish();
-  }
   [[nodiscard]] std::uint64_t dumped() const { return dumped_; }
 
  private:
   const sim::Simulation& sim_;
-  std::vector<std::unique_ptr<sim::PacketEncoder>> encoders_;
-  std::unique_ptr<sim::RecordingWriter> recording_;
-  std::optional<fs::path> scans_dir_;
-  std::vector<sim::EncodedPacket> packets_;
+  fs::path dir_;
   std::uint64_t dumped_ = 0;
 };
-
-sim::RecordingSensor endpointsOf(const sim::SensorSpec& s, const sim::LidarModel& m) {
-  sim::RecordingSensor r;
-  r.source.address = sim::ipv4FromText(s.address);
-  r.source.port = s.port;
-  r.source.mac = sim::macForAddress(r.source.address);
-  r.clock_offset_ns = s.clock_offset_ns;
-  if (m.vendor == sim::LidarVendor::kOuster) {
-    // Ouster sends unicast to the configured host: here the .100 host of the sensor's /24.
-    r.destination.address = (r.source.address & 0xffffff00u) | 100u;
-    r.destination.mac = sim::macForAddress(r.destination.address);
-  } else {
-    // Velodyne and Hesai broadcast by default.
-    r.destination.address = 0xffffffffu;
-    r.destination.mac = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff};
-  }
-  r.destination.port = s.port;
-  return r;
-}
 
 void run(const SimArgs& a) {
   if (a.list) {
@@ -108,7 +64,9 @@ void run(const SimArgs& a) {
   try {
     scenario = sim::loadScenario(a.scenario);
   } catch (const sim::ScenarioError& e) {
-    throw CommandFailed(kExitConfig, e.what());
+    // A file that is not there is an input problem; a file that is wrong is a config problem.
+    const bool is_path = a.scenario.find('/') != std::string::npos || fs::path(a.scenario).has_extension();
+    throw CommandFailed(is_path && !fs::exists(a.scenario) ? kExitInput : kExitConfig, e.what());
   }
   if (a.seed) scenario.seed = *a.seed;
   const fs::path out(a.out);
@@ -135,45 +93,41 @@ void run(const SimArgs& a) {
   sim::writeRigFiles(s, out);
   std::cout << "wrote " << (out / "truth.yaml").string() << ", poses.csv, rig.yaml and the sensors' calibration files\n";
 
-  std::vector<std::unique_ptr<sim::PacketEncoder>> encoders;
+  auto encoders = sim::makeEncoders(s);
   std::vector<std::string> missing;
-  std::vector<sim::RecordingSensor> endpoints;
-  for (std::size_t i = 0; i < s.sensorCount(); ++i) {
-    const auto& spec = scenario.sensors[i];
-    encoders.push_back(sim::makePacketEncoder(s.model(i), {spec.name, spec.port, false, scenario.seed}));
-    if (!encoders.back() && std::find(missing.begin(), missing.end(), spec.model) == missing.end())
-      missing.push_back(spec.model);
-    endpoints.push_back(endpointsOf(spec, s.model(i)));
-  }
-  std::unique_ptr<sim::RecordingWriter> recording;
+  for (std::size_t i = 0; i < s.sensorCount(); ++i)
+    if (!encoders[i] && std::find(missing.begin(), missing.end(), scenario.sensors[i].model) == missing.end())
+      missing.push_back(scenario.sensors[i].model);
   const fs::path pcap = out / "recording.pcap";
-  if (missing.empty()) {
-    recording = std::make_unique<sim::RecordingWriter>(pcap, endpoints, sim::hashKeys(scenario.seed, 0x6e6963ULL));
-  } else {
+  if (!missing.empty()) {
     std::string models;
     for (const auto& m : missing) models += (models.empty() ? "" : ", ") + m;
     if (fs::exists(pcap)) fs::remove(pcap);  // never leave a capture that does not match this run
     std::cout << "recording.pcap NOT written: there is no packet encoder yet for " << models
               << " (the vendor wire-format encoders are phase 2 of the simulator)\n";
   }
-  std::optional<fs::path> scans_dir;
-  if (a.dump_scans) scans_dir = out / "scans";
-  if (!recording && !scans_dir) {
+  std::unique_ptr<ScanDumper> dumper;
+  if (a.dump_scans) dumper = std::make_unique<ScanDumper>(s, out / "scans");
+  if (!missing.empty() && !dumper) {
     std::cout << "physics not run: nothing to write (use --dump-scans for the simulated sweeps as PCD)\n";
     return;
   }
-  OutputSink sink(s, std::move(encoders), std::move(recording), scans_dir);
   sim::SimulationOptions options;
   options.threads = a.threads;
-  options.build_scans = bool(scans_dir);
-  const sim::SimulationStats st = s.run(sink, options);
-  sink.finish();
+  options.build_scans = bool(dumper);
+  sim::SimulationStats st;
+  if (missing.empty()) {
+    const sim::RecordingResult r = sim::writeRecording(s, std::move(encoders), pcap, options, dumper.get());
+    st = r.stats;
+    std::cout << "wrote " << pcap.string() << ": " << r.datagrams << " datagrams in " << r.frames << " frames\n";
+  } else {
+    st = s.run(*dumper, options);
+  }
   std::cout << std::setprecision(2) << "simulated " << st.firings << " firings, " << st.rays << " rays, "
             << st.returns << " returns, " << st.scans << " sweeps in " << st.total_seconds << " s ("
             << std::setprecision(1) << double(st.rays) / std::max(st.cast_seconds, 1e-9) / 1e6
             << " M rays/s casting on " << a.threads << " threads)\n";
-  if (scans_dir) std::cout << "wrote " << sink.dumped() << " sweeps under " << scans_dir->string() << "\n";
-  if (missing.empty()) std::cout << "wrote " << pcap.string() << "\n";
+  if (dumper) std::cout << "wrote " << dumper->dumped() << " sweeps under " << (out / "scans").string() << "\n";
 }
 
 }  // namespace

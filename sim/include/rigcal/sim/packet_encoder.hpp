@@ -28,7 +28,9 @@ namespace rigcal::sim {
 
 struct EncodedPacket {
   std::vector<std::uint8_t> payload;  // the UDP payload
-  TimeNs send_time_ns = 0;            // when the sensor sends it, on the sensor's clock
+  // When the sensor sends it, on the sensor's clock; never before the sensor time of the last firing
+  // it carries (the capture is merged on that promise).
+  TimeNs send_time_ns = 0;
 };
 
 /// What an encoder may need beyond the model (its packets must agree with the files rig.yaml names).
@@ -51,7 +53,8 @@ class PacketEncoder {
 };
 
 /// The encoder for `model`, or nullptr when none is built in yet (the vendor encoders are phase 2 of
-/// the simulator; callers must then say so and write no capture).
+/// the simulator; callers must then say so and write no capture). writeRecording (recording.hpp)
+/// drives the encoders and writes the capture.
 std::unique_ptr<PacketEncoder> makePacketEncoder(const LidarModel& model, const EncoderConfig& config);
 
 }  // namespace rigcal::sim
