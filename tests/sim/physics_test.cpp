@@ -143,6 +143,25 @@ TEST(Physics, OutputDoesNotDependOnThreadsOrChunks) {
   }
 }
 
+TEST(Physics, SameSeedSamePointsAnotherSeedOthers) {
+  // Two independent simulations of one scenario and seed: identical sweeps, bit for bit.
+  const Scenario sc = test::movingLidar("PandarXT32", 8, 20, 0.02, 0.01);
+  const Collect a = run(Simulation(sc), 0.25), b = run(Simulation(sc), 0.25, 1);
+  ASSERT_EQ(a.scans.size(), b.scans.size());
+  for (std::size_t k = 0; k < a.scans.size(); ++k) {
+    EXPECT_EQ(a.scans[k].scan.x, b.scans[k].scan.x);
+    EXPECT_EQ(a.scans[k].scan.y, b.scans[k].scan.y);
+    EXPECT_EQ(a.scans[k].scan.z, b.scans[k].scan.z);
+    EXPECT_EQ(a.scans[k].scan.intensity, b.scans[k].scan.intensity);
+    EXPECT_EQ(a.scans[k].scan.offset_ns, b.scans[k].scan.offset_ns);
+  }
+  Scenario other = sc;
+  other.seed = sc.seed + 1;
+  const Collect c = run(Simulation(other), 0.25);
+  ASSERT_FALSE(c.scans.empty());
+  EXPECT_NE(a.scans[1].scan.x, c.scans[1].scan.x);
+}
+
 TEST(Physics, ScanPhaseSetsWhereSweepsStart) {
   // Phase 33°: the rotor passes 0° (the sweep cut) (360 − 33)/3600 s after every tenth of a second.
   const Simulation sim(test::movingLidar("VLP-16", 5, 0, 0.02, 0.0));

@@ -29,6 +29,7 @@ struct SimArgs {
   bool dump_scans = false;
   bool list = false;
   int threads = 2;
+  std::optional<double> perturb_translation_m, perturb_rotation_deg;
 };
 
 // Writes every simulated sweep as a PCD file under DIR/scans/<sensor>/.
@@ -69,6 +70,8 @@ void run(const SimArgs& a) {
     throw CommandFailed(is_path && !fs::exists(a.scenario) ? kExitInput : kExitConfig, e.what());
   }
   if (a.seed) scenario.seed = *a.seed;
+  if (a.perturb_translation_m) scenario.perturbation.translation_m = *a.perturb_translation_m;
+  if (a.perturb_rotation_deg) scenario.perturbation.rotation_deg = *a.perturb_rotation_deg;
   const fs::path out(a.out);
   std::error_code ec;
   fs::create_directories(out, ec);
@@ -142,6 +145,12 @@ void addSimCommand(CLI::App& app) {
   cmd->add_option("--threads", a->threads, "Ray-casting threads (output does not depend on it)")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  cmd->add_option("--perturb-translation", a->perturb_translation_m,
+                  "rig.yaml: initial extrinsics off the truth by this many metres (default: the scenario's, 0.3)")
+      ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--perturb-rotation", a->perturb_rotation_deg,
+                  "rig.yaml: initial extrinsics off the truth by this many degrees (default: the scenario's, 5)")
+      ->check(CLI::Range(0.0, 90.0));
   cmd->add_flag("--dump-scans", a->dump_scans, "Also write every simulated sweep as PCD under DIR/scans/<sensor>/");
   cmd->add_flag("--list", a->list, "List the preset scenarios and exit");
   cmd->footer(kExitCodesHelp);
