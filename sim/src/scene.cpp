@@ -76,6 +76,17 @@ Scene::Scene(SceneContent content, double cell_size) : content_(std::move(conten
   refs_ = flatten(cells, start_);
   patch_refs_ = flatten(patch_cells, patch_start_);
   cell_top_ = std::move(tops);
+  ref_z_.reserve(refs_.size());
+  for (const std::uint32_t ref : refs_) {
+    const std::uint32_t idx = ref & ~kTypeMask;
+    double lo = 0, hi = 0;
+    switch (ref & kTypeMask) {
+      case kBox: lo = content_.boxes[idx].z0, hi = content_.boxes[idx].z1; break;
+      case kCylinder: lo = content_.cylinders[idx].z0, hi = content_.cylinders[idx].z1; break;
+      default: lo = content_.ellipsoids[idx].cz - content_.ellipsoids[idx].rz, hi = content_.ellipsoids[idx].cz + content_.ellipsoids[idx].rz;
+    }
+    ref_z_.emplace_back(std::nextafter(float(lo), -1e30f), std::nextafter(float(hi), 1e30f));
+  }
   top_ = -1e30;
   for (float t : cell_top_) top_ = std::max(top_, double(t));
 }

@@ -62,8 +62,13 @@ bool Scene::walkCells(const Ray& ray, double t_in, double t_out, double t_min, H
     const double t_exit = std::min(w.exit(), t_out);
     const std::size_t c = std::size_t(w.iy) * std::size_t(nx_) + std::size_t(w.ix);
     const std::uint32_t begin = start_[c], end = start_[c + 1];
-    if (begin != end && std::min(oz + t * dz, oz + t_exit * dz) <= cell_top_[c]) {
+    const double z_a = oz + t * dz, z_b = oz + t_exit * dz;
+    const double z_lo = std::min(z_a, z_b), z_hi = std::max(z_a, z_b);
+    if (begin != end && z_lo <= cell_top_[c]) {
       for (std::uint32_t k = begin; k < end; ++k) {
+        // The ray passes above or below this primitive within this cell: not tested (and not marked
+        // tested: it may still be hit in another cell).
+        if (z_lo > ref_z_[k].second || z_hi < ref_z_[k].first) continue;
         const std::uint32_t ref = refs_[k], idx = ref & ~kTypeMask;
         switch (ref & kTypeMask) {
           case kBox:

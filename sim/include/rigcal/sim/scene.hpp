@@ -3,6 +3,7 @@
 // indexed by a uniform 2D grid over the ground plane (cells list the primitives whose footprint
 // overlaps them, plus the highest top in the cell so rays passing above are skipped cheaply).
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "rigcal/sim/ground.hpp"
@@ -60,6 +61,7 @@ class Scene {
   // Compressed cell lists: refs_[start_[c] .. start_[c + 1]) for cell c; patch lists likewise.
   std::vector<std::uint32_t> start_, refs_, patch_start_, patch_refs_;
   std::vector<float> cell_top_;
+  std::vector<std::pair<float, float>> ref_z_;  // per entry of refs_: its primitive's z range (rounded out)
 };
 
 }  // namespace rigcal::sim
