@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "rigcal/sim/scene.hpp"
 #include "rigcal/sim/simulation.hpp"
@@ -142,6 +143,53 @@ TEST(RayCaster, GridAgreesWithBruteForceOnTheGeneratedScene) {
   }
   EXPECT_EQ(disagreements, 0);
   EXPECT_GT(object_hits, 400) << "the scene should be feature-rich";
+}
+
+}  // namespace
+}  // namespace rigcal::sim
+
+namespace rigcal::sim {
+namespace {
+
+TEST(SceneGenerator, LayoutsHoldEveryKindOfObject) {
+  for (const std::string name : {"parking-lot", "street"}) {
+    const Simulation sim(loadScenario(name));
+    const SceneContent& c = sim.scene().content();
+    std::map<Material, int> boxes, cylinders, patches;
+    for (const auto& b : c.boxes) ++boxes[b.material];
+    for (const auto& y : c.cylinders) ++cylinders[y.material];
+    for (const auto& p : c.patches) ++patches[p.material];
+    EXPECT_GT(boxes[Material::kGlass], 2) << name << ": buildings (glass cores behind window recesses)";
+    EXPECT_GT(boxes[Material::kBrick] + boxes[Material::kPlaster], 50) << name << ": facade pillars and bands";
+    EXPECT_GT(boxes[Material::kTyre], 20) << name << ": parked cars";
+    EXPECT_GT(boxes[Material::kCurbStone], 5) << name << ": curbs";
+    EXPECT_GT(boxes[Material::kRetroReflector], 0) << name << ": signs";
+    EXPECT_GT(int(c.ellipsoids.size()), 5) << name << ": trees";
+    EXPECT_GT(cylinders[Material::kMetal] + cylinders[Material::kConcrete], 5) << name << ": poles and bollards";
+    EXPECT_GT(patches[Material::kRoadPaint], 5) << name << ": road paint";
+    // The ground is sloped and bumpy.
+    const Ground& g = c.ground;
+    EXPECT_GT(g.spec().slope.norm(), 0.005) << name;
+    double lo = 1e9, hi = -1e9;
+    for (double x = -20; x <= 20; x += 0.5) {
+      const double r = g.height(x, 3.0) - (g.spec().base_height + g.spec().slope.x() * x + g.spec().slope.y() * 3.0);
+      lo = std::min(lo, r);
+      hi = std::max(hi, r);
+    }
+    EXPECT_GT(hi - lo, 0.02) << name << ": bumps";
+  }
+}
+
+TEST(SceneGenerator, NothingStandsOnThePath) {
+  const Simulation sim(loadScenario("parking-lot"));
+  const double clearance = sim.scenario().scene.clearance_m;
+  for (const auto& p : sim.trajectory().path(0.5)) {
+    for (const auto& b : sim.scene().content().boxes) {
+      const Rect2 r = footprint(b);
+      const double dx = std::max({r.x0 - p.x(), 0.0, p.x() - r.x1}), dy = std::max({r.y0 - p.y(), 0.0, p.y() - r.y1});
+      ASSERT_GE(std::hypot(dx, dy), clearance - 1e-9);
+    }
+  }
 }
 
 }  // namespace
