@@ -23,7 +23,7 @@ void shops(const Side& side, ObjectBuilder& build, Placer& place, Rng& rng) {
   double s = rng.uniform(2, 8);
   while (s < side.length - 12) {
     const double len = std::min(rng.uniform(14, 32), side.length - s - 2);
-    const double depth = rng.uniform(10, 17), setback = rng.uniform(0.5, 4);
+    const double depth = rng.uniform(10, 16), setback = rng.uniform(0.5, 3);
     const Eigen::Vector2d c = side.at(s + 0.5 * len, setback + 0.5 * depth);
     const Rect2 fp = rotatedRect(c, side.yaw(), len, depth);
     if (len > 8 && place.free(fp)) {
@@ -43,7 +43,7 @@ void shops(const Side& side, ObjectBuilder& build, Placer& place, Rng& rng) {
   double c = 0;
   while (c < side.length) {
     const double len = rng.uniform(6, 18);
-    const Eigen::Vector2d a = side.at(c, 21.5), b = side.at(std::min(c + len, side.length), 21.5);
+    const Eigen::Vector2d a = side.at(c, 20.5), b = side.at(std::min(c + len, side.length), 20.5);
     const Rect2 r{std::min(a.x(), b.x()) - 0.2, std::min(a.y(), b.y()) - 0.2, std::max(a.x(), b.x()) + 0.2,
                   std::max(a.y(), b.y()) + 0.2};
     if (place.free(r, 0.0)) place.occupy(build.curb(a, b));
@@ -52,7 +52,7 @@ void shops(const Side& side, ObjectBuilder& build, Placer& place, Rng& rng) {
 }
 
 void largeBuilding(const Side& side, ObjectBuilder& build, Placer& place, Rng& rng) {
-  const double len = side.length * rng.uniform(0.45, 0.7), depth = rng.uniform(16, 24);
+  const double len = side.length * rng.uniform(0.45, 0.7), depth = rng.uniform(14, 20);
   const double s = rng.uniform(3, side.length - len - 3);
   const Eigen::Vector2d c = side.at(s + 0.5 * len, 1 + 0.5 * depth);
   if (place.free(rotatedRect(c, side.yaw(), len, depth)))
@@ -103,8 +103,9 @@ void streetEdge(const Side& side, ObjectBuilder& build, Placer& place, Rng& rng)
 }
 
 void stallRows(const SceneSpec& spec, ObjectBuilder& build, Placer& place, Rng& rng) {
-  const double x0 = spec.center.x() - 0.5 * spec.size.x() + 24, x1 = spec.center.x() + 0.5 * spec.size.x() - 24;
-  const double y0 = spec.center.y() - 0.5 * spec.size.y() + 26, y1 = spec.center.y() + 0.5 * spec.size.y() - 24;
+  // The sides take up to ~21 m (setback + building depth): the stalls keep 30 m from the edges.
+  const double x0 = spec.center.x() - 0.5 * spec.size.x() + 30, x1 = spec.center.x() + 0.5 * spec.size.x() - 30;
+  const double y0 = spec.center.y() - 0.5 * spec.size.y() + 30, y1 = spec.center.y() + 0.5 * spec.size.y() - 28;
   const double stall_w = rng.uniform(2.4, 2.7), stall_d = 5.0, aisle = rng.uniform(6.5, 7.5);
   for (double yc = y0 + rng.uniform(0, 4); yc < y1; yc += 2 * stall_d + aisle) {
     // Islands at both ends of the double row, with a tree and a light pole.
