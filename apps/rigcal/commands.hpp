@@ -19,5 +19,6 @@ void addDecodeCommand(CLI::App& app);
 void addDriverCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
 void addMonitorCommand(CLI::App& app);
+void addSimCommand(CLI::App& app);
 
 }  // namespace rigcal::app

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   addDriverCommand(app);
   addReplayCommand(app);
   addMonitorCommand(app);
+  addSimCommand(app);
 
   try {
     app.parse(argc, argv);

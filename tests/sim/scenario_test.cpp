@@ -1,0 +1,124 @@
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+
+#include "rigcal/config/rig_config.hpp"
+#include "rigcal/core/pcd_io.hpp"
+#include "rigcal/sim/simulation.hpp"
+#include "test_data.hpp"
+
+namespace rigcal::sim {
+namespace {
+
+std::vector<std::string> modelsOf(const Scenario& s) {
+  std::vector<std::string> m;
+  for (const auto& x : s.sensors) m.push_back(x.model);
+  return m;
+}
+
+TEST(Scenario, PresetsDescribeTheRequestedRigs) {
+  EXPECT_EQ(builtinScenarioNames(), (std::vector<std::string>{"lost", "parking-lot", "pose", "street"}));
+  const Scenario p = loadScenario("parking-lot");
+  EXPECT_EQ(modelsOf(p), (std::vector<std::string>{"OS1-64", "VLP-16", "VLP-16"}));
+  EXPECT_EQ(p.calibration_lidars.size(), 2u);
+  const Scenario s = loadScenario("street");
+  EXPECT_EQ(modelsOf(s), (std::vector<std::string>{"VLS-128", "VLP-16", "OS1-64", "PandarXT32"}));
+  const Scenario l = loadScenario("lost");
+  EXPECT_FALSE(l.sensors[0].outages.empty());
+  const Scenario q = loadScenario("pose");
+  ASSERT_TRUE(q.pose_sensor);
+  EXPECT_EQ(q.sensors.size(), 1u);
+  EXPECT_EQ(q.sensors[0].clock_offset_ns - q.pose_sensor->clock_offset_ns, 15 * kNsPerMs);
+  EXPECT_TRUE(q.trajectory.excitation.active());
+  // Sensors are not synchronised: distinct scan phases within each rig.
+  for (const Scenario* sc : {&p, &s}) {
+    std::set<double> phases;
+    for (const auto& x : sc->sensors) phases.insert(x.scan_phase_deg);
+    EXPECT_EQ(phases.size(), sc->sensors.size()) << sc->name;
+  }
+  for (const auto& name : builtinScenarioNames()) EXPECT_NO_THROW(Simulation{loadScenario(name)}) << name;
+}
+
+TEST(Scenario, MistakesAreReportedWithTheirPosition) {
+  const auto error = [](const std::string& text) {
+    try {
+      parseScenario(text, "bad.yaml");
+    } catch (const ScenarioError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string base = "scenario: x\nrig:\n  mapping_lidar: a\n  sensors:\n"
+                           "    - {name: a, model: VLP-16, address: 1.2.3.4, port: 2368, extrinsic: {z: 2}}\n"
+                           "scene: {layout: empty}\ntrajectory:\n  segments: [{type: stop, duration: 1}]\n";
+  EXPECT_EQ(error(base), "no error");
+  EXPECT_NE(error(base + "noize: {}\n").find("bad.yaml:9:1: unknown key 'noize'"), std::string::npos) << error(base + "noize: {}\n");
+  std::string bad_model = base;
+  bad_model.replace(bad_model.find("VLP-16"), 6, "VLP-17");
+  EXPECT_NE(error(bad_model).find("bad.yaml:5:"), std::string::npos);
+  EXPECT_NE(error(bad_model).find("known: VLP-16"), std::string::npos);
+  std::string bad_ip = base;
+  bad_ip.replace(bad_ip.find("1.2.3.4"), 7, "1.2.3.400");
+  EXPECT_NE(error(bad_ip).find("not an IPv4 address"), std::string::npos);
+  std::string bad_seg = base;
+  bad_seg.replace(bad_seg.find("type: stop"), 10, "type: fly");
+  EXPECT_NE(error(bad_seg).find("segment type 'fly'"), std::string::npos);
+  EXPECT_THROW(loadScenario("no-such-preset"), ScenarioError);
+}
+
+TEST(Scenario, LoadsAFileByPath) {
+  test::TempDir dir;
+  std::ofstream(dir / "mine.yaml") << "scenario: mine\nrig:\n  mapping_lidar: a\n  sensors:\n"
+                                      "    - {name: a, model: PandarXT32, address: 10.0.0.2, port: 2368, extrinsic: {z: 2}}\n"
+                                      "scene: {layout: street}\ntrajectory:\n  segments: [{type: stop, duration: 1}]\n";
+  const Scenario s = loadScenario((dir / "mine.yaml").string());
+  EXPECT_EQ(s.name, "mine");
+  EXPECT_EQ(s.file, dir / "mine.yaml");
+}
+
+std::pair<int, std::string> runRigcal(const std::string& args) {
+  const std::string cmd = test::rigcalBinary().string() + " " + args + " 2>&1";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 512> buf{};
+  while (pipe && std::fgets(buf.data(), int(buf.size()), pipe)) out += buf.data();
+  const int status = pipe ? ::pclose(pipe) : -1;
+  return {WEXITSTATUS(status), out};
+}
+
+TEST(SimCommand, WritesTruthPosesAndRigAndSaysWhyThereIsNoCapture) {
+  test::TempDir dir;
+  const auto [rc, out] = runRigcal("sim --scenario pose --out " + dir.path().string() + " --seed 5");
+  ASSERT_EQ(rc, 0) << out;
+  for (const char* f : {"truth.yaml", "poses.csv", "rig.yaml", "lidar.calibration.yaml"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  EXPECT_FALSE(std::filesystem::exists(dir / "recording.pcap")) << "never a fake capture";
+  EXPECT_NE(out.find("recording.pcap NOT written"), std::string::npos) << out;
+  EXPECT_NE(out.find("VLP-16"), std::string::npos) << out;
+  EXPECT_NO_THROW(config::loadRigConfig(dir / "rig.yaml"));
+  EXPECT_NE(runRigcal("sim --scenario nope --out " + dir.path().string()).first, 0);
+}
+
+TEST(SimCommand, DumpsSweepsAsPcd) {
+  test::TempDir dir;
+  std::ofstream(dir / "short.yaml") << "scenario: short\nrig:\n  mapping_lidar: a\n  sensors:\n"
+                                       "    - {name: a, model: VLP-16, address: 10.0.0.2, port: 2368, extrinsic: {z: 2}}\n"
+                                       "scene: {layout: parking-lot}\ntrajectory:\n"
+                                       "  start: {x: -20, y: -6, speed_kmh: 5}\n  segments: [{type: cruise, duration: 0.35}]\n";
+  const auto [rc, out] = runRigcal("sim --scenario " + (dir / "short.yaml").string() + " --out " + (dir / "o").string() +
+                                   " --dump-scans --threads 1");
+  ASSERT_EQ(rc, 0) << out;
+  std::size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "o" / "scans" / "a")) {
+    const PointTable t = readPcd(e.path());
+    EXPECT_GT(t.size(), 0u);
+    EXPECT_TRUE(t.has("offset_ns"));
+    ++n;
+  }
+  EXPECT_GE(n, 3u);
+}
+
+}  // namespace
+}  // namespace rigcal::sim
