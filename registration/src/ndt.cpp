@@ -1,0 +1,122 @@
+#include "rigcal/registration/ndt.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+
+#include "rigcal/registration/parallel.hpp"
+#include "kernels.hpp"
+#include "solver.hpp"
+
+namespace rigcal::registration {
+
+namespace {
+
+class NdtObjective final : public detail::Objective {
+ public:
+  NdtObjective(const NdtGrid& grid, const PointCloud& source, const NdtParams& params)
+      : grid_(grid), source_(source), params_(params) {
+    // PCL's constants (Magnusson 2009, eq. 6.8): a Gaussian plus a uniform outlier floor, fitted by
+    // a single Gaussian-shaped score so the derivatives stay simple.
+    const double c1 = 10.0 * (1.0 - params.outlier_ratio);
+    const double c2 = params.outlier_ratio / std::pow(params.resolution, 3);
+    const double d3 = -std::log(c2);
+    d1_ = -std::log(c1 + c2) - d3;
+    d2_ = -2.0 * std::log((-std::log(c1 * std::exp(-0.5) + c2) - d3) / d1_);
+    chunks_ = chunkCount(source.size(), kDefaultChunk);
+  }
+
+  std::optional<detail::LinearSystem> linearize(const Pose& T, const Deadline& deadline) override {
+    return run<true>(T, deadline);
+  }
+  std::optional<double> cost(const Pose& T, const Deadline& deadline) override {
+    const auto sys = run<false>(T, deadline);
+    if (!sys) return std::nullopt;
+    return sys->cost;
+  }
+  [[nodiscard]] bool reportsNeighborMetrics() const override { return false; }
+  void limitStep(Vector6d& delta) const override {
+    const double norm = delta.norm();
+    if (norm > params_.step_size) delta *= params_.step_size / norm;
+  }
+
+ private:
+  template <bool kLinearize>
+  std::optional<detail::LinearSystem> run(const Pose& T, const Deadline& deadline) const {
+    const Eigen::Matrix4d M = T.matrix();
+    std::atomic<bool> stopped{false};
+    auto sys = parallelReduce(chunks_, params_.num_threads, detail::LinearSystem{}, [&](std::size_t t) {
+      detail::LinearSystem part;
+      if (stopped.load(std::memory_order_relaxed) || deadline.expired()) {
+        stopped.store(true, std::memory_order_relaxed);
+        return part;
+      }
+      const NdtCell* cells[27];
+      const std::size_t end = std::min(source_.size(), (t + 1) * kDefaultChunk);
+      for (std::size_t i = t * kDefaultChunk; i < end; ++i) {
+        const Eigen::Vector4d x = M * source_.points[i];
+        const std::size_t n = grid_.neighbors(x, params_.neighborhood, cells);
+        if (n == 0) continue;
+        ++part.inliers;
+        Eigen::Vector3d u = Eigen::Vector3d::Zero();
+        Eigen::Matrix3d W = Eigen::Matrix3d::Zero();
+        for (std::size_t c = 0; c < n; ++c) {
+          const Eigen::Vector4d d = x - cells[c]->mean;
+          const Eigen::Vector4d Cd = cells[c]->inverse_covariance * d;
+          const double e = std::exp(-0.5 * d2_ * d.dot(Cd));
+          part.cost += d1_ * e;  // d1 < 0: lower is better
+          if constexpr (kLinearize) {
+            // Score gradient w.r.t. x: w·Σ⁻¹d with w = −d1·d2·e ≥ 0. Its Hessian w·(Σ⁻¹ − d2·Σ⁻¹d·dᵀΣ⁻¹) is
+            // indefinite far from the mean; keeping the second term anyway (as PCL does) converges
+            // quadratically near the optimum, where IRLS with w·Σ⁻¹ alone crawls. LM copes with the rest.
+            const double w = -d1_ * d2_ * e;
+            const Eigen::Vector3d g = Cd.head<3>();
+            u += w * g;
+            W += w * cells[c]->inverse_covariance.topLeftCorner<3, 3>();
+            W.noalias() -= (w * d2_) * g * g.transpose();
+          }
+        }
+        if constexpr (kLinearize) detail::addWeighted(W, x.head<3>(), u, part.H, part.b);
+      }
+      if constexpr (kLinearize) detail::mirrorUpper(part.H);
+      return part;
+    });
+    if (stopped.load()) return std::nullopt;
+    return sys;
+  }
+
+  const NdtGrid& grid_;
+  const PointCloud& source_;
+  const NdtParams& params_;
+  double d1_ = 0.0, d2_ = 0.0;
+  std::size_t chunks_ = 0;
+};
+
+}  // namespace
+
+RegistrationResult alignNdt(const Target& target, const PointCloud& source, const Pose& guess,
+                            const NdtParams& params, const Deadline& deadline) {
+  constexpr const char* kName = "NDT";
+  const SourceTarget pair{&source, &target};
+  std::string bad = detail::validateInputs({&pair, 1}, guess, params, params.max_correspondence_distance);
+  char buf[160];
+  if (bad.empty() && !(params.outlier_ratio > 0.0 && params.outlier_ratio < 1.0)) {
+    std::snprintf(buf, sizeof buf, "outlier_ratio must be in (0, 1), got %g", params.outlier_ratio);
+    bad = buf;
+  }
+  if (bad.empty() && !(params.step_size > 0.0)) bad = "step_size must be > 0";
+  const NdtGrid* grid = bad.empty() ? target.ndtGrid(params.resolution) : nullptr;
+  if (bad.empty() && grid == nullptr) {
+    std::snprintf(buf, sizeof buf, "target has no NDT grid of resolution %g m (add it to ndt_resolutions)",
+                  params.resolution);
+    bad = buf;
+  }
+  if (bad.empty() && grid->empty()) bad = "target's NDT grid has no voxel with enough points";
+  if (!bad.empty()) return detail::invalid(guess, std::string(kName) + ": " + bad, params.max_correspondence_distance);
+  NdtObjective objective(*grid, source, params);
+  const std::span<const SourceTarget> pairs(&pair, 1);
+  const detail::SolveOutcome outcome = detail::solve(objective, guess, params, deadline);
+  return detail::finish(outcome, objective, pairs, params.max_correspondence_distance, params, deadline, kName);
+}
+
+}  // namespace rigcal::registration
