@@ -13,9 +13,8 @@ namespace rigcal::registration::detail {
 
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
-/// H += Jᵀ·W·J and b += Jᵀ·u with u = W·r (W symmetric): the GICP and NDT form.
-inline void addWeighted(const Eigen::Matrix3d& W, const Eigen::Vector3d& q, const Eigen::Vector3d& u, Matrix6d& H,
-                        Vector6d& b) {
+/// H += Jᵀ·W·J (W symmetric), upper triangle.
+inline void addWeightedHessian(const Eigen::Matrix3d& W, const Eigen::Vector3d& q, Matrix6d& H) {
   const double x = q.x(), y = q.y(), z = q.z();
   // V = W·[q]×, column by column.
   const Eigen::Vector3d v0 = W.col(1) * z - W.col(2) * y;
@@ -37,8 +36,19 @@ inline void addWeighted(const Eigen::Matrix3d& W, const Eigen::Vector3d& q, cons
   H(4, 4) += x * v1.z() - z * v1.x();
   H(4, 5) += x * v2.z() - z * v2.x();
   H(5, 5) += y * v2.x() - x * v2.y();
+}
+
+/// b += Jᵀ·u.
+inline void addGradient(const Eigen::Vector3d& q, const Eigen::Vector3d& u, Vector6d& b) {
   b.head<3>() += u;
   b.tail<3>() += q.cross(u);
+}
+
+/// H += Jᵀ·W·J and b += Jᵀ·u with u = W·r: the GICP form.
+inline void addWeighted(const Eigen::Matrix3d& W, const Eigen::Vector3d& q, const Eigen::Vector3d& u, Matrix6d& H,
+                        Vector6d& b) {
+  addWeightedHessian(W, q, H);
+  addGradient(q, u, b);
 }
 
 /// One scalar residual e with gradient row j = [n, q × n]: H += jᵀj, b += jᵀe (point-to-plane).

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/Cholesky>
+
 #include "rigcal/registration/parallel.hpp"
 #include "kernels.hpp"
 #include "solver.hpp"
@@ -27,26 +29,40 @@ class NdtObjective final : public detail::Objective {
   }
 
   std::optional<detail::LinearSystem> linearize(const Pose& T, const Deadline& deadline) override {
-    return run<true>(T, deadline);
+    std::optional<Sums> sums = run<true>(T, deadline);
+    if (!sums) return std::nullopt;
+    if (Eigen::LLT<detail::Matrix6d>(sums->H_newton).info() == Eigen::Success) sums->sys.H = sums->H_newton;
+    return sums->sys;
   }
   std::optional<double> cost(const Pose& T, const Deadline& deadline) override {
-    const auto sys = run<false>(T, deadline);
-    if (!sys) return std::nullopt;
-    return sys->cost;
+    const std::optional<Sums> sums = run<false>(T, deadline);
+    if (!sums) return std::nullopt;
+    return sums->sys.cost;
   }
   [[nodiscard]] bool reportsNeighborMetrics() const override { return false; }
-  void limitStep(Vector6d& delta) const override {
-    const double norm = delta.norm();
-    if (norm > params_.step_size) delta *= params_.step_size / norm;
-  }
+  [[nodiscard]] double maxStep() const override { return params_.step_size; }
 
  private:
+  // What a chunk adds up. H_newton is the score's Hessian (without the transform's second derivatives),
+  // exact and quadratically convergent near the optimum but indefinite far from it; H_gauss keeps only
+  // the w·Σ⁻¹ part (always PSD, the reweighted Gauss–Newton / IRLS matrix). linearize() uses the first
+  // when it is positive definite and falls back to the second.
+  struct Sums {
+    detail::LinearSystem sys;  // sys.H is H_gauss
+    detail::Matrix6d H_newton = detail::Matrix6d::Zero();
+    Sums& operator+=(const Sums& o) {
+      sys += o.sys;
+      H_newton += o.H_newton;
+      return *this;
+    }
+  };
+
   template <bool kLinearize>
-  std::optional<detail::LinearSystem> run(const Pose& T, const Deadline& deadline) const {
+  std::optional<Sums> run(const Pose& T, const Deadline& deadline) const {
     const Eigen::Matrix4d M = T.matrix();
     std::atomic<bool> stopped{false};
-    auto sys = parallelReduce(chunks_, params_.num_threads, detail::LinearSystem{}, [&](std::size_t t) {
-      detail::LinearSystem part;
+    Sums total = parallelReduce(chunks_, params_.num_threads, Sums{}, [&](std::size_t t) {
+      Sums part;
       if (stopped.load(std::memory_order_relaxed) || deadline.expired()) {
         stopped.store(true, std::memory_order_relaxed);
         return part;
@@ -57,32 +73,39 @@ class NdtObjective final : public detail::Objective {
         const Eigen::Vector4d x = M * source_.points[i];
         const std::size_t n = grid_.neighbors(x, params_.neighborhood, cells);
         if (n == 0) continue;
-        ++part.inliers;
+        ++part.sys.inliers;
         Eigen::Vector3d u = Eigen::Vector3d::Zero();
         Eigen::Matrix3d W = Eigen::Matrix3d::Zero();
+        Eigen::Matrix3d V = Eigen::Matrix3d::Zero();  // the −d2·(Σ⁻¹d)(Σ⁻¹d)ᵀ part
         for (std::size_t c = 0; c < n; ++c) {
           const Eigen::Vector4d d = x - cells[c]->mean;
           const Eigen::Vector4d Cd = cells[c]->inverse_covariance * d;
           const double e = std::exp(-0.5 * d2_ * d.dot(Cd));
-          part.cost += d1_ * e;  // d1 < 0: lower is better
+          part.sys.cost += d1_ * e;  // d1 < 0: lower is better
           if constexpr (kLinearize) {
-            // Score gradient w.r.t. x: w·Σ⁻¹d with w = −d1·d2·e ≥ 0. Its Hessian w·(Σ⁻¹ − d2·Σ⁻¹d·dᵀΣ⁻¹) is
-            // indefinite far from the mean; keeping the second term anyway (as PCL does) converges
-            // quadratically near the optimum, where IRLS with w·Σ⁻¹ alone crawls. LM copes with the rest.
+            // Gradient of d1·e w.r.t. x: w·Σ⁻¹d with w = −d1·d2·e ≥ 0.
             const double w = -d1_ * d2_ * e;
             const Eigen::Vector3d g = Cd.head<3>();
             u += w * g;
             W += w * cells[c]->inverse_covariance.topLeftCorner<3, 3>();
-            W.noalias() -= (w * d2_) * g * g.transpose();
+            V.noalias() -= (w * d2_) * g * g.transpose();
           }
         }
-        if constexpr (kLinearize) detail::addWeighted(W, x.head<3>(), u, part.H, part.b);
+        if constexpr (kLinearize) {
+          const Eigen::Vector3d q = x.head<3>();
+          detail::addWeightedHessian(W, q, part.sys.H);
+          detail::addWeightedHessian(W + V, q, part.H_newton);
+          detail::addGradient(q, u, part.sys.b);
+        }
       }
-      if constexpr (kLinearize) detail::mirrorUpper(part.H);
+      if constexpr (kLinearize) {
+        detail::mirrorUpper(part.sys.H);
+        detail::mirrorUpper(part.H_newton);
+      }
       return part;
     });
     if (stopped.load()) return std::nullopt;
-    return sys;
+    return total;
   }
 
   const NdtGrid& grid_;

@@ -40,15 +40,20 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
     // tangents in point-to-plane) get a zero step instead of a singular solve.
     Vector6d diag = sys->H.diagonal().cwiseAbs();
     diag = diag.cwiseMax(1e-9 * std::max(diag.maxCoeff(), 1e-30));
+    // Each rejected try damps more and halves the trust radius, so steps shrink geometrically until
+    // the cost drops (a descent direction always gets there) or they are negligibly small.
     bool accepted = false;
     Vector6d delta = Vector6d::Zero();
     Pose T_new = out.T;
-    for (int attempt = 0; attempt < 12 && !accepted; ++attempt) {
+    double radius = objective.maxStep();
+    for (int attempt = 0; attempt < 20 && !accepted; ++attempt) {
       Matrix6d A = sys->H;
       A.diagonal() += lambda * diag;
       delta = A.ldlt().solve(-sys->b);
-      objective.limitStep(delta);
-      if (!delta.allFinite()) {
+      const double norm = delta.norm();
+      if (norm > radius) delta *= radius / norm;
+      // Not a descent direction for the local model (an indefinite Hessian) or no step at all: damp more.
+      if (!delta.allFinite() || !(sys->b.dot(delta) < 0.0)) {
         lambda *= 10.0;
         continue;
       }
@@ -64,6 +69,7 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
         lambda = std::max(lambda * 0.1, 1e-12);
       } else {
         lambda *= 10.0;
+        radius = 0.5 * std::min(radius, delta.norm());
       }
     }
     out.iterations = it + 1;

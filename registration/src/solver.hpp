@@ -2,6 +2,7 @@
 // Private: the Levenberg–Marquardt loop every registration runs, and the shared ending (metrics at the
 // result pose, degeneracy check, status and reason).
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -51,8 +52,8 @@ class Objective {
   /// Nearest-neighbour metrics at T (inliers and sum_sq_distance filled) if the objective can get them
   /// cheaper than a fresh evaluation; nullopt means "use evaluatePairs" (or the deadline passed).
   virtual std::optional<LinearSystem> measure(const Pose& /*T*/, const Deadline& /*deadline*/) { return std::nullopt; }
-  /// Shrinks an update in place (NDT's step_size); no-op by default.
-  virtual void limitStep(Vector6d& /*delta*/) const {}
+  /// Largest update norm allowed per iteration (NDT's step_size); unlimited by default.
+  [[nodiscard]] virtual double maxStep() const { return std::numeric_limits<double>::infinity(); }
 };
 
 struct SolveOutcome {
