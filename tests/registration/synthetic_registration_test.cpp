@@ -98,8 +98,9 @@ TEST(Deadline, ReturnsInTimeWithTheBestSoFar) {
     const RegistrationResult r = test::run(m, target, big, Pose::Identity(), {}, Deadline::after(budget));
     const auto elapsed = std::chrono::steady_clock::now() - start;
     EXPECT_EQ(r.status, Status::kTimeout) << r.reason;
-    // One chunk of 512 points is the longest it can overrun, even in a sanitizer build.
-    EXPECT_LT(elapsed, budget + std::chrono::milliseconds(150)) << test::name(m);
+    // It overruns by at most one chunk of 512 points per thread (a few ms even under sanitizers); the
+    // slack is for a loaded 2-core CI machine that deschedules us. Unbounded, this takes seconds.
+    EXPECT_LT(elapsed, budget + std::chrono::milliseconds(400)) << test::name(m);
     EXPECT_TRUE(r.T_target_source.matrix().allFinite());
     EXPECT_LE(test::translationError(r.T_target_source, test::knownTransform()),
               test::translationError(Pose::Identity(), test::knownTransform()) + 1e-12);
