@@ -14,6 +14,9 @@ namespace rigcal::registration {
 
 namespace {
 
+// A cell whose Gaussian has fallen below exp(−30) at the point (about 8σ away) adds nothing measurable.
+constexpr double kNegligible = 30.0;
+
 class NdtObjective final : public detail::Objective {
  public:
   NdtObjective(const NdtGrid& grid, const PointCloud& source, const NdtParams& params)
@@ -29,15 +32,24 @@ class NdtObjective final : public detail::Objective {
   }
 
   std::optional<detail::LinearSystem> linearize(const Pose& T, const Deadline& deadline) override {
-    std::optional<Sums> sums = run<true>(T, deadline);
+    std::optional<Sums> sums;
+    if (cached_ && cached_at_ == T.matrix()) {
+      sums = std::move(cached_);
+    } else {
+      sums = run(T, deadline);
+    }
+    cached_.reset();
     if (!sums) return std::nullopt;
     if (Eigen::LLT<detail::Matrix6d>(sums->H_newton).info() == Eigen::Success) sums->sys.H = sums->H_newton;
     return sums->sys;
   }
+  // NDT has no fixed matches, so the cost at a trial pose is a full pass anyway: linearise there too and
+  // keep it, since an accepted trial pose is exactly where the next linearize() runs.
   std::optional<double> cost(const Pose& T, const Deadline& deadline) override {
-    const std::optional<Sums> sums = run<false>(T, deadline);
-    if (!sums) return std::nullopt;
-    return sums->sys.cost;
+    cached_ = run(T, deadline);
+    if (!cached_) return std::nullopt;
+    cached_at_ = T.matrix();
+    return cached_->sys.cost;
   }
   [[nodiscard]] bool reportsNeighborMetrics() const override { return false; }
   [[nodiscard]] double maxStep() const override { return params_.step_size; }
@@ -57,7 +69,6 @@ class NdtObjective final : public detail::Objective {
     }
   };
 
-  template <bool kLinearize>
   std::optional<Sums> run(const Pose& T, const Deadline& deadline) const {
     const Eigen::Matrix4d M = T.matrix();
     std::atomic<bool> stopped{false};
@@ -68,10 +79,19 @@ class NdtObjective final : public detail::Objective {
         return part;
       }
       const NdtCell* cells[27];
+      std::size_t n = 0;
+      NdtGrid::Voxel last;
+      bool have_last = false;  // consecutive scan points often share a voxel: reuse its lookups
       const std::size_t end = std::min(source_.size(), (t + 1) * kDefaultChunk);
       for (std::size_t i = t * kDefaultChunk; i < end; ++i) {
         const Eigen::Vector4d x = M * source_.points[i];
-        const std::size_t n = grid_.neighbors(x, params_.neighborhood, cells);
+        NdtGrid::Voxel v;
+        if (!grid_.voxelOf(x, &v)) continue;
+        if (!have_last || !(v == last)) {
+          n = grid_.neighbors(v, params_.neighborhood, cells);
+          last = v;
+          have_last = true;
+        }
         if (n == 0) continue;
         ++part.sys.inliers;
         Eigen::Vector3d u = Eigen::Vector3d::Zero();
@@ -80,34 +100,32 @@ class NdtObjective final : public detail::Objective {
         for (std::size_t c = 0; c < n; ++c) {
           const Eigen::Vector4d d = x - cells[c]->mean;
           const Eigen::Vector4d Cd = cells[c]->inverse_covariance * d;
-          const double e = std::exp(-0.5 * d2_ * d.dot(Cd));
+          const double exponent = 0.5 * d2_ * d.dot(Cd);
+          if (exponent > kNegligible) continue;  // contributes < 1e-13 of a matched point: skip the exp
+          const double e = std::exp(-exponent);
           part.sys.cost += d1_ * e;  // d1 < 0: lower is better
-          if constexpr (kLinearize) {
-            // Gradient of d1·e w.r.t. x: w·Σ⁻¹d with w = −d1·d2·e ≥ 0.
-            const double w = -d1_ * d2_ * e;
-            const Eigen::Vector3d g = Cd.head<3>();
-            u += w * g;
-            W += w * cells[c]->inverse_covariance.topLeftCorner<3, 3>();
-            V.noalias() -= (w * d2_) * g * g.transpose();
-          }
+          // Gradient of d1·e w.r.t. x: w·Σ⁻¹d with w = −d1·d2·e ≥ 0.
+          const double w = -d1_ * d2_ * e;
+          const Eigen::Vector3d g = Cd.head<3>();
+          u += w * g;
+          W += w * cells[c]->inverse_covariance.topLeftCorner<3, 3>();
+          V.noalias() -= (w * d2_) * g * g.transpose();
         }
-        if constexpr (kLinearize) {
-          const Eigen::Vector3d q = x.head<3>();
-          detail::addWeightedHessian(W, q, part.sys.H);
-          detail::addWeightedHessian(W + V, q, part.H_newton);
-          detail::addGradient(q, u, part.sys.b);
-        }
+        const Eigen::Vector3d q = x.head<3>();
+        detail::addWeightedHessian(W, q, part.sys.H);
+        detail::addWeightedHessian(W + V, q, part.H_newton);
+        detail::addGradient(q, u, part.sys.b);
       }
-      if constexpr (kLinearize) {
-        detail::mirrorUpper(part.sys.H);
-        detail::mirrorUpper(part.H_newton);
-      }
+      detail::mirrorUpper(part.sys.H);
+      detail::mirrorUpper(part.H_newton);
       return part;
     });
     if (stopped.load()) return std::nullopt;
     return total;
   }
 
+  std::optional<Sums> cached_;
+  Eigen::Matrix4d cached_at_ = Eigen::Matrix4d::Zero();
   const NdtGrid& grid_;
   const PointCloud& source_;
   const NdtParams& params_;

@@ -90,10 +90,21 @@ const NdtCell* NdtGrid::find(std::int64_t x, std::int64_t y, std::int64_t z) con
   }
 }
 
-std::size_t NdtGrid::neighbors(const Eigen::Vector4d& p, NdtNeighborhood which, const NdtCell** out) const {
-  if (cells_.empty()) return 0;
+bool NdtGrid::voxelOf(const Eigen::Vector4d& p, Voxel* out) const {
   detail::VoxelCoord c;
-  if (!detail::voxelCoord(p, inv_resolution_, &c)) return 0;
+  if (!detail::voxelCoord(p, inv_resolution_, &c)) return false;
+  *out = {c.x, c.y, c.z};
+  return true;
+}
+
+std::size_t NdtGrid::neighbors(const Eigen::Vector4d& p, NdtNeighborhood which, const NdtCell** out) const {
+  Voxel v;
+  if (cells_.empty() || !voxelOf(p, &v)) return 0;
+  return neighbors(v, which, out);
+}
+
+std::size_t NdtGrid::neighbors(const Voxel& c, NdtNeighborhood which, const NdtCell** out) const {
+  if (cells_.empty()) return 0;
   std::size_t n = 0;
   auto visit = [&](std::int64_t dx, std::int64_t dy, std::int64_t dz) {
     if (const NdtCell* cell = find(c.x + dx, c.y + dy, c.z + dz)) out[n++] = cell;

@@ -11,7 +11,7 @@
 namespace rigcal::registration {
 
 struct CovarianceOptions {
-  int num_neighbors = 20;        // k, PCL GICP's k_correspondences default
+  int num_neighbors = 10;        // k; PCL GICP uses 20, small_gicp 10: about as accurate on our scans, half the cost
   double plane_epsilon = 1e-3;   // PCL GICP's gicp_epsilon
   int num_threads = 1;
 };

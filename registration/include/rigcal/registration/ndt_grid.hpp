@@ -4,6 +4,7 @@
 // fewer than min_points_per_voxel points are left out and small eigenvalues are raised to
 // min_eigenvalue_ratio × the largest, so flat voxels stay invertible. Immutable once built.
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -44,6 +45,15 @@ class NdtGrid {
 
   /// Cells around p (at most 27 written to `out`); returns how many.
   std::size_t neighbors(const Eigen::Vector4d& p, NdtNeighborhood which, const NdtCell** out) const;
+
+  /// The integer voxel of p; false for a point no voxel can hold (non-finite, absurdly far).
+  struct Voxel {
+    std::int64_t x = 0, y = 0, z = 0;
+    friend bool operator==(const Voxel&, const Voxel&) = default;
+  };
+  bool voxelOf(const Eigen::Vector4d& p, Voxel* out) const;
+  /// Cells around a voxel (at most 27 written to `out`); returns how many.
+  std::size_t neighbors(const Voxel& v, NdtNeighborhood which, const NdtCell** out) const;
 
  private:
   struct Slot {
