@@ -15,6 +15,7 @@
 #include "rigcal/registration/deadline.hpp"
 #include "rigcal/registration/evaluator.hpp"
 #include "rigcal/registration/registration_result.hpp"
+#include "rigcal/registration/solver_params.hpp"
 #include "rigcal/registration/target.hpp"
 
 namespace rigcal::registration::detail {

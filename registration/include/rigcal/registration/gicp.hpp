@@ -6,6 +6,7 @@
 #include "rigcal/registration/deadline.hpp"
 #include "rigcal/registration/point_cloud.hpp"
 #include "rigcal/registration/registration_result.hpp"
+#include "rigcal/registration/solver_params.hpp"
 #include "rigcal/registration/target.hpp"
 
 namespace rigcal::registration {

@@ -9,6 +9,7 @@
 #include "rigcal/registration/ndt_grid.hpp"
 #include "rigcal/registration/point_cloud.hpp"
 #include "rigcal/registration/registration_result.hpp"
+#include "rigcal/registration/solver_params.hpp"
 #include "rigcal/registration/target.hpp"
 
 namespace rigcal::registration {
