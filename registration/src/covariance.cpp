@@ -15,7 +15,8 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
                                     NeighborGraph* graph, std::size_t graph_degree) {
   const std::size_t n = cloud.size();
   const std::size_t k = static_cast<std::size_t>(std::max(options.num_neighbors, 3));
-  const std::size_t degree = graph != nullptr ? std::min(graph_degree, k - 1) : 0;
+  const std::size_t degree = graph != nullptr ? graph_degree : 0;
+  const std::size_t k_query = std::max(k, degree + 2);  // the graph may want more points than the covariance
   if (graph != nullptr) {
     graph->degree = degree;
     graph->neighbors.assign(n * degree, 0);
@@ -28,18 +29,18 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
   std::atomic<std::size_t> isolated{0};
 
   parallelFor(chunkCount(n, kDefaultChunk), options.num_threads, [&](std::size_t task) {
-    std::vector<Neighbor> nb(k);
+    std::vector<Neighbor> nb(k_query);
     const std::size_t begin = task * kDefaultChunk;
     const std::size_t end = std::min(n, begin + kDefaultChunk);
     std::size_t local_isolated = 0;
     for (std::size_t i = begin; i < end; ++i) {
-      const std::size_t found = tree.knn(cloud.points[i], k, nb.data());
+      const std::size_t all = tree.knn(cloud.points[i], k_query, nb.data());
       if (degree > 0) {
         // Sorted by distance; list the first `degree` others. The next other point bounds the distance
         // of everything not listed: that is the radius the list vouches for.
         std::uint32_t* list = graph->neighbors.data() + i * degree;
-        std::size_t m = 0, next = found;
-        for (std::size_t j = 0; j < found; ++j) {
+        std::size_t m = 0, next = all;
+        for (std::size_t j = 0; j < all; ++j) {
           if (nb[j].index == i) continue;
           if (m == degree) {
             next = j;
@@ -47,8 +48,9 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
           }
           list[m++] = nb[j].index;
         }
-        if (m == degree && next < found) graph->radius[i] = std::sqrt(nb[next].sq_distance);
+        if (m == degree && next < all) graph->radius[i] = std::sqrt(nb[next].sq_distance);
       }
+      const std::size_t found = std::min(all, k);  // the covariance uses the k nearest only
       if (found < 3) {
         cloud.covariances[i].topLeftCorner<3, 3>().setIdentity();
         ++local_isolated;

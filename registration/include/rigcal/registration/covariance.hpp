@@ -22,7 +22,7 @@ struct CovarianceStats {
 };
 
 /// Fills cloud.normals and cloud.covariances. `tree` must have been built over cloud.points.
-/// With `graph`, also records each point's min(num_neighbors − 1, graph_degree) nearest other points.
+/// With `graph`, also records each point's graph_degree nearest other points (from the same k-NN pass).
 CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const CovarianceOptions& options = {},
                                     NeighborGraph* graph = nullptr, std::size_t graph_degree = 10);
 /// Same, building a temporary tree over the cloud first.
