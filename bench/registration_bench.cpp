@@ -1,0 +1,376 @@
+// rigcal registration against PCL 1.13 on the same real data, one run. Scan-to-scan: the VLS-128
+// reference scan within 22 m, 0.25 m voxels (~18k points), against itself moved by a known transform
+// with 1 cm noise. Scan-to-map: the same source against a ~255k-point map: the full scan densified along
+// its scan lines at 5 cm voxels (192k), merged with the XT32 reference scan (63k) 600 m away (map content
+// the source does not see, as in a real map). Every benchmark is one alignment per repetition; median and p99 over
+// repetitions, error against the known transform as counters, and a side-by-side table at the end.
+// Run pinned: taskset -c 0 (1 thread) and taskset -c 0,1 (2 threads). Skips when the data is missing.
+#include <benchmark/benchmark.h>
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_types.h>
+#include <pcl/registration/gicp.h>
+#include <pcl/registration/icp.h>
+#include <pcl/registration/ndt.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "rigcal/core/pcd_io.hpp"
+#include "rigcal/registration/covariance.hpp"
+#include "rigcal/registration/gicp.hpp"
+#include "rigcal/registration/icp.hpp"
+#include "rigcal/registration/ndt.hpp"
+#include "rigcal/registration/voxel_grid.hpp"
+
+namespace {
+
+using namespace rigcal;
+using namespace rigcal::registration;
+using PclCloud = pcl::PointCloud<pcl::PointXYZ>;
+
+struct Scenario {
+  std::string name;
+  std::unique_ptr<Target> target;  // everything: tree, covariances + graph, NDT grid 1.0
+  PclCloud::Ptr pcl_target;
+};
+
+struct Data {
+  PointCloud raw;
+  PointCloud source;       // positions only
+  PointCloud source_cov;   // with covariances (for "align only")
+  PclCloud::Ptr pcl_source;
+  Pose truth;
+  Scenario scan, map;
+};
+std::unique_ptr<Data> g_data;
+
+PclCloud::Ptr toPcl(const PointCloud& c) {
+  auto out = std::make_shared<PclCloud>();
+  out->reserve(c.size());
+  for (const auto& p : c.points) out->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  return out;
+}
+
+PointCloud cropped(const PointCloud& c, double range) {
+  PointCloud out;
+  for (const auto& p : c.points) {
+    if (p.head<3>().norm() < range) out.points.push_back(p);
+  }
+  return out;
+}
+
+void load(const std::filesystem::path& path, const std::filesystem::path& other) {
+  auto d = std::make_unique<Data>();
+  d->raw = fromTable(readPcd(path));
+  d->truth = fromXyzRpy({0.3, -0.2, 0.05, deg2rad(1.0), deg2rad(-0.5), deg2rad(3.0)});
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  PointCloud moved = transformed(d->raw, d->truth.inverse());
+  for (auto& p : moved.points) p.head<3>() += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+  d->source = voxelDownsample(cropped(moved, 22.0), 0.25);
+  d->source_cov = d->source;
+  estimateCovariances(d->source_cov);
+  d->pcl_source = toPcl(d->source);
+
+  TargetOptions options;
+  options.normals_and_covariances = true;
+  options.ndt_resolutions = {1.0};
+  options.num_threads = 2;
+  const PointCloud scan = voxelDownsample(cropped(d->raw, 22.0), 0.25);
+  d->scan = {"s2s", std::make_unique<Target>(scan, options), toPcl(scan)};
+  // Densify along scan lines: midpoints of consecutive returns closer than 0.3 m lie on the surfaces.
+  PointCloud dense = d->raw;
+  for (std::size_t i = 1; i < d->raw.size(); ++i) {
+    const Eigen::Vector4d a = d->raw.points[i - 1], b = d->raw.points[i];
+    if ((a - b).norm() < 0.3) dense.points.push_back(0.5 * (a + b));
+  }
+  PointCloud map = voxelDownsample(dense, 0.05);
+  for (const auto& p : fromTable(readPcd(other)).points) map.points.push_back(p + Eigen::Vector4d(600.0, 0, 0, 0));
+  d->map = {"s2m", std::make_unique<Target>(map, options), toPcl(map)};
+  std::printf("data: raw %zu, source %zu, scan target %zu, map target %zu points\n", d->raw.size(),
+              d->source.size(), scan.size(), map.size());
+  g_data = std::move(d);
+}
+
+void setErrors(benchmark::State& state, const Pose& estimate) {
+  const Pose e = g_data->truth.inverse() * estimate;
+  state.counters["t_err_mm"] = e.translation().norm() * 1e3;
+  state.counters["r_err_deg"] = rad2deg(rotationAngle(e));
+}
+
+template <class P>
+P common(int threads) {
+  P p;
+  p.num_threads = threads;
+  p.max_iterations = 64;
+  p.transformation_epsilon = 1e-4;
+  p.rotation_epsilon = 1e-4;
+  return p;
+}
+
+// ---- ours ------------------------------------------------------------------------------------------------
+void oursGicp(benchmark::State& state, const Scenario* s, bool with_source_covariances) {
+  const auto params = [&] {
+    auto p = common<GicpParams>(static_cast<int>(state.range(0)));
+    p.max_correspondence_distance = 1.0;
+    return p;
+  }();
+  RegistrationResult r;
+  for (auto _ : state) {
+    if (with_source_covariances) {
+      PointCloud src = g_data->source;
+      CovarianceOptions co;
+      co.num_threads = params.num_threads;
+      estimateCovariances(src, co);
+      r = alignGicp(*s->target, src, Pose::Identity(), params);
+    } else {
+      r = alignGicp(*s->target, g_data->source_cov, Pose::Identity(), params);
+    }
+  }
+  setErrors(state, r.T_target_source);
+  state.counters["iterations"] = r.iterations;
+}
+
+void oursNdt(benchmark::State& state, const Scenario* s) {
+  auto params = common<NdtParams>(static_cast<int>(state.range(0)));
+  RegistrationResult r;
+  for (auto _ : state) r = alignNdt(*s->target, g_data->source, Pose::Identity(), params);
+  setErrors(state, r.T_target_source);
+  state.counters["iterations"] = r.iterations;
+}
+
+void oursIcp(benchmark::State& state, const Scenario* s, IcpMethod method) {
+  auto params = common<IcpParams>(static_cast<int>(state.range(0)));
+  params.method = method;
+  params.max_correspondence_distance = 1.0;
+  RegistrationResult r;
+  for (auto _ : state) r = alignIcp(*s->target, g_data->source, Pose::Identity(), params);
+  setErrors(state, r.T_target_source);
+  state.counters["iterations"] = r.iterations;
+}
+
+// ---- PCL (single-threaded in 1.13); same limits: 1 m correspondences, 64 iterations, 1e-4 m / rad -----------
+template <class Reg>
+void runPcl(benchmark::State& state, Reg& reg, const Scenario* s) {
+  reg.setInputTarget(s->pcl_target);
+  reg.setInputSource(g_data->pcl_source);
+  PclCloud out;
+  reg.align(out);  // warm-up: builds and caches the target side (tree, covariances, grid), like our Target
+  for (auto _ : state) {
+    reg.setInputSource(g_data->pcl_source);  // source-side work (GICP covariances) is redone per align
+    reg.align(out);
+  }
+  setErrors(state, Pose(reg.getFinalTransformation().template cast<double>()));
+  state.counters["converged"] = reg.hasConverged();
+}
+
+void pclGicp(benchmark::State& state, const Scenario* s) {
+  pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> reg;
+  reg.setMaxCorrespondenceDistance(1.0);
+  reg.setMaximumIterations(64);
+  reg.setTransformationEpsilon(1e-4);
+  reg.setRotationEpsilon(1e-4);
+  runPcl(state, reg, s);
+}
+
+void pclNdt(benchmark::State& state, const Scenario* s) {
+  pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> reg;
+  reg.setResolution(1.0);
+  reg.setStepSize(0.1);
+  reg.setOulierRatio(0.55);
+  reg.setMaximumIterations(64);
+  reg.setTransformationEpsilon(1e-8);                  // squared translation of the last step (m²)
+  reg.setTransformationRotationEpsilon(1.0 - 5e-9);   // cos of its rotation: 1e-4 rad
+  runPcl(state, reg, s);
+}
+
+void pclIcp(benchmark::State& state, const Scenario* s) {
+  pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> reg;
+  reg.setMaxCorrespondenceDistance(1.0);
+  reg.setMaximumIterations(64);
+  reg.setTransformationEpsilon(1e-8);
+  reg.setTransformationRotationEpsilon(1.0 - 5e-9);
+  runPcl(state, reg, s);
+}
+
+// ---- building blocks -------------------------------------------------------------------------------------
+void oursNearest(benchmark::State& state, const Scenario* s) {
+  const KdTree& tree = s->target->tree();
+  const Eigen::Matrix4d M = g_data->truth.matrix();
+  std::size_t found = 0;
+  for (auto _ : state) {
+    for (const auto& p : g_data->source.points) {
+      Neighbor nb;
+      found += tree.nearest(M * p, 1.0, &nb);
+    }
+  }
+  state.counters["found"] = static_cast<double>(found) / static_cast<double>(state.iterations());
+}
+
+void pclNearest(benchmark::State& state, const Scenario* s) {
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(s->pcl_target);
+  const Eigen::Matrix4d M = g_data->truth.matrix();
+  std::vector<int> idx(1);
+  std::vector<float> d2(1);
+  std::size_t found = 0;
+  for (auto _ : state) {
+    for (const auto& p : g_data->source.points) {
+      const Eigen::Vector4d q = M * p;
+      const int n = tree.nearestKSearch(pcl::PointXYZ(float(q.x()), float(q.y()), float(q.z())), 1, idx, d2);
+      found += n > 0 && d2[0] < 1.0F;  // the same question: the nearest point within 1 m
+    }
+  }
+  state.counters["found"] = static_cast<double>(found) / static_cast<double>(state.iterations());
+}
+
+void oursTreeBuild(benchmark::State& state, const Scenario* s) {
+  for (auto _ : state) benchmark::DoNotOptimize(KdTree(s->target->cloud().points));
+}
+void pclTreeBuild(benchmark::State& state, const Scenario* s) {
+  for (auto _ : state) {
+    pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+    tree.setInputCloud(s->pcl_target);
+    benchmark::DoNotOptimize(tree);
+  }
+}
+
+void oursVoxel(benchmark::State& state) {
+  std::size_t n = 0;
+  for (auto _ : state) n = voxelDownsample(g_data->raw, 0.1).size();
+  state.counters["points_out"] = static_cast<double>(n);
+}
+void pclVoxel(benchmark::State& state) {
+  const PclCloud::Ptr raw = toPcl(g_data->raw);
+  PclCloud out;
+  for (auto _ : state) {
+    pcl::VoxelGrid<pcl::PointXYZ> grid;
+    grid.setInputCloud(raw);
+    grid.setLeafSize(0.1F, 0.1F, 0.1F);  // 412 x 452 x 61 m: 1.1e10 voxels overflow PCL's int index
+    grid.filter(out);
+  }
+  state.counters["points_out"] = static_cast<double>(out.size());
+}
+
+void oursTarget(benchmark::State& state, const Scenario* s) {
+  TargetOptions options;
+  options.normals_and_covariances = true;
+  options.ndt_resolutions = {1.0};
+  options.num_threads = static_cast<int>(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(Target(s->target->cloud(), options));
+}
+
+double percentile99(const std::vector<double>& v) {
+  std::vector<double> s = v;
+  std::sort(s.begin(), s.end());
+  return s.empty() ? 0.0 : s[std::min(s.size() - 1, static_cast<std::size_t>(std::ceil(0.99 * s.size())) - 1)];
+}
+
+// Collects median / p99 and the error counters to print the comparison table at the end.
+struct Row {
+  double median = NAN, median_cpu = NAN, p99 = NAN, t_err = NAN, r_err = NAN;
+};
+std::map<std::string, Row> g_rows;
+
+class TableReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& r : runs) {
+      if (r.run_type != Run::RT_Aggregate) continue;
+      Row& row = g_rows[r.run_name.str()];
+      if (r.aggregate_name == "median") {
+        row.median = r.GetAdjustedRealTime();
+        row.median_cpu = r.GetAdjustedCPUTime();
+        if (r.counters.count("t_err_mm")) row.t_err = r.counters.at("t_err_mm");
+        if (r.counters.count("r_err_deg")) row.r_err = r.counters.at("r_err_deg");
+      } else if (r.aggregate_name == "p99") {
+        row.p99 = r.GetAdjustedRealTime();
+      }
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+};
+
+void printTable() {
+  auto get = [](const std::string& name) {
+    for (const auto& [key, row] : g_rows) {
+      if (key.rfind(name, 0) == 0) return row;
+    }
+    return Row{};
+  };
+  // Wall-clock medians and p99s; in brackets the main thread's CPU time (what a loaded machine cannot
+  // inflate for 1 thread). PCL/ours compares wall-clock medians with one thread each.
+  std::printf("\n%-4s %-9s | %-26s | %-26s | %-26s | %-8s | %-17s | %-17s\n", "", "method",
+              "ours 1T med (cpu) / p99 ms", "ours 2T med (cpu) / p99 ms", "PCL med (cpu) / p99 ms", "PCL/ours",
+              "ours err mm / deg", "PCL err mm / deg");
+  for (const char* scenario : {"s2s", "s2m"}) {
+    for (const auto& [method, pcl] : std::vector<std::pair<std::string, std::string>>{
+             {"GICP+cov", "GICP"}, {"GICP", ""}, {"NDT", "NDT"}, {"ICP", "ICP"}, {"ICP-plane", ""}}) {
+      const std::string base = std::string(scenario) + "/" + method + "/ours/";
+      const Row one = get(base + "threads:1"), two = get(base + "threads:2");
+      const Row theirs = pcl.empty() ? Row{} : get(std::string(scenario) + "/" + pcl + "/pcl");
+      std::printf("%-4s %-9s | %7.1f (%7.1f) / %7.1f | %7.1f (%7.1f) / %7.1f | %7.0f (%7.0f) / %7.0f | %7.1fx | %6.3f / %.5f | "
+                  "%6.3f / %.5f\n",
+                  scenario, method.c_str(), one.median, one.median_cpu, one.p99, two.median, two.median_cpu, two.p99,
+                  theirs.median, theirs.median_cpu, theirs.p99, theirs.median / one.median, one.t_err, one.r_err,
+                  theirs.t_err, theirs.r_err);
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const char* env = std::getenv("RIGCAL_DATA_DIR");
+  const std::filesystem::path dir = env && *env ? env : RIGCAL_DEFAULT_DATA_DIR;
+  const std::filesystem::path scan = dir / "velodyne/vls128_strongest.reference.pcd";
+  const std::filesystem::path other = dir / "hesai/xt32_dual.reference.pcd";
+  for (const auto& f : {scan, other}) {
+    if (!std::filesystem::exists(f)) {
+      std::printf("SKIPPED: shared data not found: %s (set RIGCAL_DATA_DIR)\n", f.c_str());
+      return 0;
+    }
+  }
+  benchmark::Initialize(&argc, argv);
+  load(scan, other);
+  const auto stats = [](benchmark::internal::Benchmark* b, int reps) {
+    b->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(reps);
+    b->ComputeStatistics("p99", percentile99)->ReportAggregatesOnly(true);
+  };
+  for (Scenario* s : {&g_data->scan, &g_data->map}) {
+    const std::string n = s->name + "/";
+    const int pcl_reps = s == &g_data->scan ? 5 : 3;
+    for (const int t : {1, 2}) {
+      const std::string th = "/ours/threads:" + std::to_string(t);
+      stats(benchmark::RegisterBenchmark((n + "GICP+cov" + th).c_str(), oursGicp, s, true)->Arg(t), 20);
+      stats(benchmark::RegisterBenchmark((n + "GICP" + th).c_str(), oursGicp, s, false)->Arg(t), 20);
+      stats(benchmark::RegisterBenchmark((n + "NDT" + th).c_str(), oursNdt, s)->Arg(t), 20);
+      stats(benchmark::RegisterBenchmark((n + "ICP" + th).c_str(), oursIcp, s, IcpMethod::kPointToPoint)->Arg(t), 20);
+      stats(benchmark::RegisterBenchmark((n + "ICP-plane" + th).c_str(), oursIcp, s, IcpMethod::kPointToPlane)->Arg(t),
+            20);
+      stats(benchmark::RegisterBenchmark((n + "target-build" + th).c_str(), oursTarget, s)->Arg(t), 5);
+    }
+    stats(benchmark::RegisterBenchmark((n + "GICP/pcl").c_str(), pclGicp, s), pcl_reps);
+    stats(benchmark::RegisterBenchmark((n + "NDT/pcl").c_str(), pclNdt, s), pcl_reps);
+    stats(benchmark::RegisterBenchmark((n + "ICP/pcl").c_str(), pclIcp, s), pcl_reps);
+    stats(benchmark::RegisterBenchmark((n + "nearest/ours").c_str(), oursNearest, s), 10);
+    stats(benchmark::RegisterBenchmark((n + "nearest/pcl").c_str(), pclNearest, s), 10);
+    stats(benchmark::RegisterBenchmark((n + "tree-build/ours").c_str(), oursTreeBuild, s), 10);
+    stats(benchmark::RegisterBenchmark((n + "tree-build/pcl").c_str(), pclTreeBuild, s), 10);
+  }
+  stats(benchmark::RegisterBenchmark("voxel-0.1m/ours", oursVoxel), 10);
+  stats(benchmark::RegisterBenchmark("voxel-0.1m/pcl", pclVoxel), 10);
+  TableReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  printTable();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,93 @@
+#pragma once
+// Exact nearest-neighbour search in 3-D: a flat, balanced kd-tree (median splits on the widest axis,
+// small leaves, nodes in one array in pre-order). It keeps its own copy of the points in leaf order as
+// float offsets from the cloud's centre, so leaves are contiguous in memory and far-from-origin (UTM) maps
+// lose no precision. bench/registration_bench.cpp compares it with pcl::KdTreeFLANN.
+// Immutable after construction: any number of threads may query one tree.
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace rigcal::registration {
+
+struct KdTreeOptions {
+  std::size_t leaf_size = 12;  // points per leaf (bench: 8..16 are all within a few % of each other)
+  int num_threads = 1;         // threads building the two halves below the root (result is identical)
+};
+
+struct Neighbor {
+  std::uint32_t index = 0;  // into the point array the tree was built from
+  float sq_distance = 0.0F;
+};
+
+/// Each point's nearest other points (a by-product of the covariance pass). Every point of the cloud
+/// that is not listed for j is at least radius[j] from point j, which lets a search that starts at a
+/// previous match prove its answer exact without touching the tree (see the ICP matcher).
+struct NeighborGraph {
+  std::size_t degree = 0;                // entries per point
+  std::vector<std::uint32_t> neighbors;  // degree × size, closest first
+  std::vector<float> radius;             // per point; 0 when it cannot vouch for anything
+
+  [[nodiscard]] bool empty() const { return degree == 0 || radius.empty(); }
+  [[nodiscard]] std::span<const std::uint32_t> of(std::size_t j) const {
+    return {neighbors.data() + j * degree, degree};
+  }
+};
+
+class KdTree {
+ public:
+  static constexpr std::uint32_t kNoHint = std::numeric_limits<std::uint32_t>::max();
+
+  KdTree() = default;
+  /// Builds over the xyz of `points` (w is ignored); they must be finite. At most 2^32 − 2 points.
+  explicit KdTree(std::span<const Eigen::Vector4d> points, const KdTreeOptions& options = {});
+
+  [[nodiscard]] std::size_t size() const { return index_.size(); }
+  [[nodiscard]] bool empty() const { return index_.empty(); }
+
+  /// The nearest point closer than sqrt(max_sq_distance); false when there is none.
+  /// `hint` (an index probably close to q, e.g. last iteration's match) only speeds the search up.
+  bool nearest(const Eigen::Vector4d& q, double max_sq_distance, Neighbor* out,
+               std::uint32_t hint = kNoHint) const;
+
+  /// Original index of the i-th point in leaf order. A cloud stored in this order makes spatially close
+  /// queries touch close memory; see useLeafOrderIndices().
+  [[nodiscard]] const std::vector<std::uint32_t>& leafOrder() const { return index_; }
+  /// After the caller has stored its points in leafOrder(), makes every index the tree reports (and
+  /// takes as a hint) refer to that new order.
+  void useLeafOrderIndices();
+
+  /// Up to k nearest points closer than sqrt(max_sq_distance), closest first; returns how many.
+  /// `hints` (distinct indices, e.g. last iteration's k nearest) seed the search; they only speed it up.
+  std::size_t knn(const Eigen::Vector4d& q, std::size_t k, Neighbor* out,
+                  double max_sq_distance = std::numeric_limits<double>::infinity(),
+                  std::span<const std::uint32_t> hints = {}) const;
+
+ private:
+  struct Node {
+    float lo = 0, hi = 0;      // inner: largest coordinate on `axis` in the left child, smallest in the right
+    std::uint32_t begin = 0;   // points [begin, end) below this node
+    std::uint32_t end = 0;
+    std::uint32_t right = 0;   // inner: index of the right child (the left child follows this node)
+    std::uint32_t axis = 3;    // 0..2, or 3 for a leaf
+  };
+  struct Build;
+
+  [[nodiscard]] Eigen::Vector4f local(const Eigen::Vector4d& q) const;
+  template <class Set>
+  void search(const Eigen::Vector4f& q, Set& set) const;
+  [[nodiscard]] float initialBound(const Eigen::Vector4f& q, float* off) const;
+
+  Eigen::Vector3d center_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3f box_min_ = Eigen::Vector3f::Zero(), box_max_ = Eigen::Vector3f::Zero();
+  std::vector<Eigen::Vector4f> points_;  // leaf order, relative to center_, w = 0
+  std::vector<std::uint32_t> index_;     // leaf order → original index
+  std::vector<std::uint32_t> where_;     // original index → leaf order (for hints)
+  std::vector<Node> nodes_;
+};
+
+}  // namespace rigcal::registration

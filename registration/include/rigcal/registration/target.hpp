@@ -1,0 +1,63 @@
+#pragma once
+// Everything a registration needs from its target, built once: the cloud, its kd-tree, and on request
+// normals + GICP covariances and NDT grids. Immutable after construction, so one Target (typically held
+// in a std::shared_ptr<const Target>) serves any number of registrations on any number of threads.
+#include <cstddef>
+#include <vector>
+
+#include "rigcal/registration/covariance.hpp"
+#include "rigcal/registration/nearest_neighbors.hpp"
+#include "rigcal/registration/ndt_grid.hpp"
+#include "rigcal/registration/point_cloud.hpp"
+
+namespace rigcal::registration {
+
+struct TargetOptions {
+  bool normals_and_covariances = false;  // needed by point-to-plane ICP and GICP
+  /// The NeighborGraph that lets ICP/GICP re-match without the tree. Always built (for free) with the
+  /// covariances; set this to also build it for a target without them (one k-NN pass).
+  bool neighbor_graph = false;
+  std::size_t neighbor_graph_degree = 10;
+  std::vector<double> ndt_resolutions;   // one NdtGrid per entry (NDT needs the one it is run with)
+  CovarianceOptions covariance;          // its num_threads is overridden by num_threads below
+  NdtGridOptions ndt;                    // its resolution is overridden by each entry above
+  KdTreeOptions tree;
+  int num_threads = 1;
+};
+
+class Target {
+ public:
+  Target() = default;
+  /// Drops non-finite points (which invalidates normals/covariances the cloud came with), then builds
+  /// the tree and whatever `options` asks for that the cloud does not already carry. The points are
+  /// stored in the tree's leaf order (neighbours close in memory: fewer cache misses when matching), so
+  /// cloud() indices differ from the input's.
+  explicit Target(PointCloud cloud, const TargetOptions& options = {});
+
+  [[nodiscard]] const PointCloud& cloud() const { return cloud_; }
+  [[nodiscard]] const KdTree& tree() const { return tree_; }
+  [[nodiscard]] std::size_t size() const { return cloud_.size(); }
+  [[nodiscard]] bool empty() const { return cloud_.empty(); }
+  [[nodiscard]] bool hasNormals() const { return cloud_.hasNormals(); }
+  [[nodiscard]] bool hasCovariances() const { return cloud_.hasCovariances(); }
+  /// Empty unless built (see TargetOptions::neighbor_graph).
+  [[nodiscard]] const NeighborGraph& neighborGraph() const { return graph_; }
+  /// The grid built for this resolution (within 1e-9 m), or nullptr.
+  [[nodiscard]] const NdtGrid* ndtGrid(double resolution) const;
+  [[nodiscard]] std::size_t droppedNonFinite() const { return dropped_; }
+
+ private:
+  PointCloud cloud_;
+  KdTree tree_;
+  NeighborGraph graph_;
+  std::vector<NdtGrid> grids_;
+  std::size_t dropped_ = 0;
+};
+
+/// One (source, target) pair of a batched registration or evaluation. Non-owning.
+struct SourceTarget {
+  const PointCloud* source = nullptr;
+  const Target* target = nullptr;
+};
+
+}  // namespace rigcal::registration

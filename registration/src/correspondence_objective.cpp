@@ -1,0 +1,251 @@
+#include "correspondence_objective.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <limits>
+
+#include "kernels.hpp"
+#include "rigcal/registration/parallel.hpp"
+
+namespace rigcal::registration::detail {
+
+// Residual r = q − t with q = T·p the transformed source point and t its matched target point.
+// See kernels.hpp for the Jacobian and how each method's blocks are accumulated.
+
+CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> pairs, Residual kind,
+                                                 double max_distance, int num_threads)
+    : pairs_(pairs), kind_(kind), max_sq_(max_distance * max_distance), num_threads_(num_threads) {
+  chunks_ = makeChunks(pairs);
+  std::size_t total = 0;
+  for (const auto& p : pairs) total += p.source->size();
+  match_.assign(total, kNone);
+  used_.assign(total, kNone);
+  second_.assign(total, kNone);
+  query_.assign(total, Eigen::Vector3f::Zero());
+  margin_.assign(total, -1.0F);
+  if (kind == Residual::kGicp) weight_.resize(total);
+}
+
+// Every target point outside {c} ∪ N(c) is at least R_c from c, hence at least R_c − |q − c| from q. So
+// when the best candidate in {c} ∪ N(c) is closer than that, it is the exact nearest point, and
+// min(second best, R_c − |q − c|) bounds the runner-up: enough for the margin.
+bool CorrespondenceObjective::graphSearch(const Target& target, std::uint32_t start, const Eigen::Vector4d& q,
+                                          std::uint32_t* j, float* margin) const {
+  constexpr float kSlack = 1e-4F;  // float rounding in the graph's radii
+  const NeighborGraph& graph = target.neighborGraph();
+  const std::vector<Eigen::Vector4d>& pts = target.cloud().points;
+  std::uint32_t c = start;
+  for (int hop = 0; hop < 3; ++hop) {
+    const double dc2 = (q - pts[c]).squaredNorm();
+    std::uint32_t best = c;
+    double best2 = dc2, second2 = std::numeric_limits<double>::infinity();
+    for (const std::uint32_t k : graph.of(c)) {
+      const double d2 = (q - pts[k]).squaredNorm();
+      if (d2 < best2) {
+        second2 = best2;
+        best2 = d2;
+        best = k;
+      } else if (d2 < second2) {
+        second2 = d2;
+      }
+    }
+    const float limit = graph.radius[c] - static_cast<float>(std::sqrt(dc2)) - kSlack;
+    const float best_d = static_cast<float>(std::sqrt(best2));
+    if (best_d < limit) {
+      if (best2 > max_sq_) {
+        *j = kNone;
+        return true;
+      }
+      *j = best;
+      *margin = 0.5F * (std::min(static_cast<float>(std::sqrt(second2)), limit) - best_d) - kSlack;
+      return true;
+    }
+    if (best == c) return false;
+    c = best;  // walk towards q and try again from there
+  }
+  return false;
+}
+
+bool CorrespondenceObjective::match(const Target& target, std::size_t g, const Eigen::Vector4d& q,
+                                    std::uint32_t* j) {
+  const Eigen::Vector3f qf = q.head<3>().cast<float>();
+  const std::uint32_t last = match_[g];
+  if (last != kNone && margin_[g] > 0.0F && (qf - query_[g]).squaredNorm() < margin_[g] * margin_[g]) {
+    *j = last;
+    return true;
+  }
+  query_[g] = qf;
+  if (last != kNone && !target.neighborGraph().empty()) {
+    std::uint32_t found = kNone;
+    float margin = 0.0F;
+    if (graphSearch(target, last, q, &found, &margin)) {
+      match_[g] = found;
+      margin_[g] = margin;
+      *j = found;
+      return found != kNone;
+    }
+  }
+  Neighbor nb[2];
+  std::uint32_t hints[2];
+  std::size_t num_hints = 0;
+  if (last != kNone) hints[num_hints++] = last;
+  if (second_[g] != kNone) hints[num_hints++] = second_[g];
+  const std::size_t found = target.tree().knn(q, 2, nb, max_sq_, {hints, num_hints});
+  if (found == 0) {
+    match_[g] = kNone;
+    second_[g] = kNone;
+    return false;
+  }
+  second_[g] = found == 2 ? nb[1].index : kNone;
+  // With no second point within range, the range bounds the runner-up instead. 1e-4 m absorbs the
+  // float rounding of the tree's distances.
+  const float second = found == 2 ? std::sqrt(nb[1].sq_distance) : static_cast<float>(std::sqrt(max_sq_));
+  margin_[g] = 0.5F * (second - std::sqrt(nb[0].sq_distance)) - 1e-4F;
+  match_[g] = nb[0].index;
+  *j = nb[0].index;
+  return true;
+}
+
+template <Residual K>
+LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) {
+  const PointCloud& source = *pairs_[chunk.pair].source;
+  const Target& target = *pairs_[chunk.pair].target;
+  const PointCloud& tc = target.cloud();
+  const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();
+  LinearSystem sys;
+  PointToPointSums p2p;
+  for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+    const std::size_t g = chunk.offset + (i - chunk.begin);
+    const Eigen::Vector4d q4 = M * source.points[i];
+    std::uint32_t j = kNone;
+    used_[g] = kNone;
+    if (!match(target, g, q4, &j)) continue;
+    const Eigen::Vector3d q = q4.head<3>();
+    const Eigen::Vector3d r = q - tc.points[j].head<3>();
+    const double d2 = r.squaredNorm();
+    if (d2 > max_sq_) continue;  // exact distance just outside the (float) search radius
+    if constexpr (K == Residual::kPointToPlane) {
+      const Eigen::Vector3d n = tc.normals[j].head<3>();
+      if (n.squaredNorm() < 0.5) continue;  // no normal known there
+      const double e = n.dot(r);
+      Vector6d row;
+      row << n, q.cross(n);
+      addRow(row, e, sys.H, sys.b);
+      sys.cost += e * e;
+    } else if constexpr (K == Residual::kGicp) {
+      const Eigen::Matrix3d fused =
+          tc.covariances[j].topLeftCorner<3, 3>() + rotateSymmetric(R, source.covariances[i].topLeftCorner<3, 3>());
+      const Eigen::Matrix3d W = inverseSymmetric(fused);
+      weight_[g] = W;
+      const Eigen::Vector3d u = W * r;
+      addWeighted(W, q, u, sys.H, sys.b);
+      sys.cost += r.dot(u);
+    } else {
+      p2p.add(q);
+      sys.b.head<3>() += r;
+      sys.b.tail<3>() += q.cross(r);
+      sys.cost += d2;
+    }
+    used_[g] = j;
+    ++sys.inliers;
+    sys.sum_sq_distance += d2;
+  }
+  if constexpr (K == Residual::kPointToPoint) p2p.finish(sys.H);
+  mirrorUpper(sys.H);
+  return sys;
+}
+
+template <Residual K>
+double CorrespondenceObjective::costChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) const {
+  const PointCloud& source = *pairs_[chunk.pair].source;
+  const PointCloud& tc = pairs_[chunk.pair].target->cloud();
+  double cost = 0.0;
+  for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+    const std::size_t g = chunk.offset + (i - chunk.begin);
+    const std::uint32_t j = used_[g];  // the same matches as the linearisation: the cost is comparable
+    if (j == kNone) continue;
+    const Eigen::Vector3d r = (M * source.points[i] - tc.points[j]).head<3>();
+    if constexpr (K == Residual::kPointToPlane) {
+      const double e = tc.normals[j].head<3>().dot(r);
+      cost += e * e;
+    } else if constexpr (K == Residual::kGicp) {
+      cost += r.dot(weight_[g] * r);
+    } else {
+      cost += r.squaredNorm();
+    }
+  }
+  return cost;
+}
+
+std::optional<LinearSystem> CorrespondenceObjective::linearize(const Pose& T, const Deadline& deadline) {
+  const Eigen::Matrix4d M = T.matrix();
+  std::atomic<bool> stopped{false};
+  LinearSystem sys = parallelReduce(chunks_.size(), num_threads_, LinearSystem{}, [&](std::size_t t) {
+    if (stopped.load(std::memory_order_relaxed) || deadline.expired()) {
+      stopped.store(true, std::memory_order_relaxed);
+      return LinearSystem{};
+    }
+    switch (kind_) {
+      case Residual::kPointToPlane:
+        return linearizeChunk<Residual::kPointToPlane>(chunks_[t], M);
+      case Residual::kGicp:
+        return linearizeChunk<Residual::kGicp>(chunks_[t], M);
+      case Residual::kPointToPoint:
+        break;
+    }
+    return linearizeChunk<Residual::kPointToPoint>(chunks_[t], M);
+  });
+  if (stopped.load()) return std::nullopt;
+  return sys;
+}
+
+std::optional<LinearSystem> CorrespondenceObjective::measure(const Pose& T, const Deadline& deadline) {
+  const Eigen::Matrix4d M = T.matrix();
+  std::atomic<bool> stopped{false};
+  LinearSystem sys = parallelReduce(chunks_.size(), num_threads_, LinearSystem{}, [&](std::size_t t) {
+    LinearSystem part;
+    if (stopped.load(std::memory_order_relaxed) || deadline.expired()) {
+      stopped.store(true, std::memory_order_relaxed);
+      return part;
+    }
+    const PairChunk& chunk = chunks_[t];
+    const PointCloud& source = *pairs_[chunk.pair].source;
+    const Target& target = *pairs_[chunk.pair].target;
+    for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+      const Eigen::Vector4d q = M * source.points[i];
+      std::uint32_t j = kNone;
+      if (!match(target, chunk.offset + (i - chunk.begin), q, &j)) continue;
+      const double d2 = (q - target.cloud().points[j]).squaredNorm();
+      if (d2 > max_sq_) continue;
+      ++part.inliers;
+      part.sum_sq_distance += d2;
+    }
+    return part;
+  });
+  if (stopped.load()) return std::nullopt;
+  return sys;
+}
+
+std::optional<double> CorrespondenceObjective::cost(const Pose& T, const Deadline& deadline) {
+  const Eigen::Matrix4d M = T.matrix();
+  std::atomic<bool> stopped{false};
+  const double total = parallelReduce(chunks_.size(), num_threads_, 0.0, [&](std::size_t t) {
+    if (stopped.load(std::memory_order_relaxed) || deadline.expired()) {
+      stopped.store(true, std::memory_order_relaxed);
+      return 0.0;
+    }
+    switch (kind_) {
+      case Residual::kPointToPlane:
+        return costChunk<Residual::kPointToPlane>(chunks_[t], M);
+      case Residual::kGicp:
+        return costChunk<Residual::kGicp>(chunks_[t], M);
+      case Residual::kPointToPoint:
+        break;
+    }
+    return costChunk<Residual::kPointToPoint>(chunks_[t], M);
+  });
+  if (stopped.load()) return std::nullopt;
+  return total;
+}
+
+}  // namespace rigcal::registration::detail

@@ -1,0 +1,54 @@
+#pragma once
+// Private: nearest-neighbour objectives (point-to-point, point-to-plane, GICP) over one or several
+// (source, target) pairs that share one pose.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "solver.hpp"
+
+namespace rigcal::registration::detail {
+
+enum class Residual { kPointToPoint, kPointToPlane, kGicp };
+
+class CorrespondenceObjective final : public Objective {
+ public:
+  /// Point-to-plane needs target normals, GICP source and target covariances (checked by the caller).
+  CorrespondenceObjective(std::span<const SourceTarget> pairs, Residual kind, double max_distance, int num_threads);
+
+  std::optional<LinearSystem> linearize(const Pose& T, const Deadline& deadline) override;
+  std::optional<double> cost(const Pose& T, const Deadline& deadline) override;
+  /// Matches only, through the same cache: after convergence almost no point needs the tree.
+  std::optional<LinearSystem> measure(const Pose& T, const Deadline& deadline) override;
+
+ private:
+  template <Residual K>
+  LinearSystem linearizeChunk(const PairChunk& chunk, const Eigen::Matrix4d& M);
+  template <Residual K>
+  double costChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) const;
+
+  /// The nearest target point of source point g (global index) at q, reusing the last one when q has
+  /// moved less than half the gap between the last nearest and second-nearest distances: then, by the
+  /// triangle inequality, no other point can have overtaken it. Exact, and most late-iteration queries
+  /// skip the tree entirely.
+  bool match(const Target& target, std::size_t g, const Eigen::Vector4d& q, std::uint32_t* j);
+  /// Exact nearest point by walking the target's NeighborGraph from `start`; false when the graph
+  /// cannot prove the answer (then the tree decides). On success *j is kNone if it is beyond range.
+  bool graphSearch(const Target& target, std::uint32_t start, const Eigen::Vector4d& q, std::uint32_t* j,
+                   float* margin) const;
+
+  static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+  std::span<const SourceTarget> pairs_;
+  Residual kind_;
+  double max_sq_;
+  int num_threads_;
+  std::vector<PairChunk> chunks_;
+  std::vector<std::uint32_t> match_;    // per source point (concatenated): target index or kNone
+  std::vector<std::uint32_t> used_;     // the match if the last linearisation used it, else kNone
+  std::vector<std::uint32_t> second_;   // the second nearest at the last search (a search hint), or kNone
+  std::vector<Eigen::Vector3f> query_;  // where the last tree search for it ran
+  std::vector<float> margin_;           // how far it may move from there keeping the match (m)
+  std::vector<Eigen::Matrix3d> weight_; // GICP: (C_t + R·C_s·Rᵀ)⁻¹ at the last linearisation
+};
+
+}  // namespace rigcal::registration::detail

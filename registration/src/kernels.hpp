@@ -1,0 +1,115 @@
+#pragma once
+// Private: per-match contributions to the Gauss–Newton system, written out by hand because they run
+// millions of times per second and Eigen's generic 3x3/6x6 products leave much of the work on the table.
+//
+// All methods perturb the pose on the left, in the target frame: T ← exp(δ)·T with δ = (ρ, ω). For a
+// transformed source point q = T·p that gives dq/dδ = J = [I, −[q]×]. Only the upper triangle of H is
+// accumulated; mirrorUpper() completes it once per chunk.
+#include <Eigen/Core>
+
+#include "rigcal/core/pose.hpp"
+
+namespace rigcal::registration::detail {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+/// H += Jᵀ·W·J (W symmetric), upper triangle.
+inline void addWeightedHessian(const Eigen::Matrix3d& W, const Eigen::Vector3d& q, Matrix6d& H) {
+  const double x = q.x(), y = q.y(), z = q.z();
+  // V = W·[q]×, column by column.
+  const Eigen::Vector3d v0 = W.col(1) * z - W.col(2) * y;
+  const Eigen::Vector3d v1 = W.col(2) * x - W.col(0) * z;
+  const Eigen::Vector3d v2 = W.col(0) * y - W.col(1) * x;
+  H(0, 0) += W(0, 0);
+  H(0, 1) += W(0, 1);
+  H(0, 2) += W(0, 2);
+  H(1, 1) += W(1, 1);
+  H(1, 2) += W(1, 2);
+  H(2, 2) += W(2, 2);
+  H.block<3, 1>(0, 3) -= v0;
+  H.block<3, 1>(0, 4) -= v1;
+  H.block<3, 1>(0, 5) -= v2;
+  // [q]×ᵀ·V, upper triangle: row i of [q]×ᵀ is (0, z, −y), (−z, 0, x), (y, −x, 0).
+  H(3, 3) += z * v0.y() - y * v0.z();
+  H(3, 4) += z * v1.y() - y * v1.z();
+  H(3, 5) += z * v2.y() - y * v2.z();
+  H(4, 4) += x * v1.z() - z * v1.x();
+  H(4, 5) += x * v2.z() - z * v2.x();
+  H(5, 5) += y * v2.x() - x * v2.y();
+}
+
+/// b += Jᵀ·u.
+inline void addGradient(const Eigen::Vector3d& q, const Eigen::Vector3d& u, Vector6d& b) {
+  b.head<3>() += u;
+  b.tail<3>() += q.cross(u);
+}
+
+/// H += Jᵀ·W·J and b += Jᵀ·u with u = W·r: the GICP form.
+inline void addWeighted(const Eigen::Matrix3d& W, const Eigen::Vector3d& q, const Eigen::Vector3d& u, Matrix6d& H,
+                        Vector6d& b) {
+  addWeightedHessian(W, q, H);
+  addGradient(q, u, b);
+}
+
+/// One scalar residual e with gradient row j = [n, q × n]: H += jᵀj, b += jᵀe (point-to-plane).
+inline void addRow(const Vector6d& j, double e, Matrix6d& H, Vector6d& b) {
+  for (int c = 0; c < 6; ++c) {
+    for (int r = 0; r <= c; ++r) H(r, c) += j[r] * j[c];
+  }
+  b += j * e;
+}
+
+/// Point-to-point sums: J = [I, −[q]×] has JᵀJ = [[I, −[q]×], [[q]×, |q|²I − qqᵀ]], so a chunk only
+/// needs the count, Σq, Σ|q|² and Σqqᵀ; turned into H by finish().
+struct PointToPointSums {
+  double n = 0.0;
+  Eigen::Vector3d sum_q = Eigen::Vector3d::Zero();
+  double sum_qq = 0.0;
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+
+  void add(const Eigen::Vector3d& q) {
+    n += 1.0;
+    sum_q += q;
+    sum_qq += q.squaredNorm();
+    outer.noalias() += q * q.transpose();
+  }
+  void finish(Matrix6d& H) const {
+    H.topLeftCorner<3, 3>() += n * Eigen::Matrix3d::Identity();
+    H.topRightCorner<3, 3>() -= skew(sum_q);
+    H.bottomRightCorner<3, 3>() += sum_qq * Eigen::Matrix3d::Identity() - outer;
+  }
+};
+
+inline void mirrorUpper(Matrix6d& H) { H.triangularView<Eigen::StrictlyLower>() = H.transpose(); }
+
+/// (A)⁻¹ for a symmetric positive-definite 3x3, by cofactors (the fused GICP covariance).
+inline Eigen::Matrix3d inverseSymmetric(const Eigen::Matrix3d& A) {
+  const double c00 = A(1, 1) * A(2, 2) - A(1, 2) * A(1, 2);
+  const double c01 = A(0, 2) * A(1, 2) - A(0, 1) * A(2, 2);
+  const double c02 = A(0, 1) * A(1, 2) - A(0, 2) * A(1, 1);
+  const double c11 = A(0, 0) * A(2, 2) - A(0, 2) * A(0, 2);
+  const double c12 = A(0, 1) * A(0, 2) - A(0, 0) * A(1, 2);
+  const double c22 = A(0, 0) * A(1, 1) - A(0, 1) * A(0, 1);
+  const double inv_det = 1.0 / (A(0, 0) * c00 + A(0, 1) * c01 + A(0, 2) * c02);
+  Eigen::Matrix3d out;
+  out << c00, c01, c02, c01, c11, c12, c02, c12, c22;
+  return out * inv_det;
+}
+
+/// R·C·Rᵀ for symmetric C.
+inline Eigen::Matrix3d rotateSymmetric(const Eigen::Matrix3d& R, const Eigen::Matrix3d& C) {
+  const Eigen::Matrix3d RC = R * C;
+  Eigen::Matrix3d out;
+  out(0, 0) = RC.row(0).dot(R.row(0));
+  out(0, 1) = RC.row(0).dot(R.row(1));
+  out(0, 2) = RC.row(0).dot(R.row(2));
+  out(1, 1) = RC.row(1).dot(R.row(1));
+  out(1, 2) = RC.row(1).dot(R.row(2));
+  out(2, 2) = RC.row(2).dot(R.row(2));
+  out(1, 0) = out(0, 1);
+  out(2, 0) = out(0, 2);
+  out(2, 1) = out(1, 2);
+  return out;
+}
+
+}  // namespace rigcal::registration::detail

@@ -1,0 +1,93 @@
+#include "rigcal/registration/covariance.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rigcal/registration/ndt_grid.hpp"
+#include "rigcal/registration/target.hpp"
+#include "scenes.hpp"
+
+namespace rigcal::registration {
+namespace {
+
+TEST(Covariance, PlaneGivesItsNormalAndPlaneRegularisedCovariance) {
+  PointCloud c = test::plane(0.1);
+  for (auto& p : c.points) p.z() = 2.0;  // the plane z = 2 seen from the origin below it
+  const CovarianceStats stats = estimateCovariances(c);
+  EXPECT_EQ(stats.without_neighborhood, 0u);
+  ASSERT_TRUE(c.hasNormals() && c.hasCovariances());
+  for (std::size_t i = 0; i < c.size(); i += 97) {
+    EXPECT_NEAR(c.normals[i].z(), -1.0, 1e-9) << "normal must face the sensor at the origin";
+    const Eigen::Matrix3d C = c.covariances[i].topLeftCorner<3, 3>();
+    EXPECT_NEAR(C(0, 0), 1.0, 1e-9);
+    EXPECT_NEAR(C(1, 1), 1.0, 1e-9);
+    EXPECT_NEAR(C(2, 2), 1e-3, 1e-9);
+    EXPECT_EQ(c.covariances[i].row(3).norm() + c.covariances[i].col(3).norm(), 0.0);
+  }
+}
+
+TEST(Covariance, TooFewNeighboursIsIsotropicWithoutNormal) {
+  PointCloud c;
+  c.add(0, 0, 0);
+  c.add(1, 0, 0);
+  const CovarianceStats stats = estimateCovariances(c);
+  EXPECT_EQ(stats.without_neighborhood, 2u);
+  EXPECT_EQ(c.normals[0].norm(), 0.0);
+  EXPECT_TRUE((c.covariances[0].topLeftCorner<3, 3>().isIdentity()));
+}
+
+TEST(Covariance, SameResultWithTwoThreads) {
+  PointCloud a = test::room(0.2), b = a;
+  CovarianceOptions two;
+  two.num_threads = 2;
+  estimateCovariances(a);
+  estimateCovariances(b, two);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a.covariances[i], b.covariances[i]);
+    ASSERT_EQ(a.normals[i], b.normals[i]);
+  }
+}
+
+TEST(NdtGrid, GaussiansOfOccupiedVoxels) {
+  const PointCloud c = test::room(0.1);
+  NdtGridOptions options;
+  options.resolution = 1.0;
+  const NdtGrid grid(c, options);
+  EXPECT_GT(grid.size(), 100u);
+  const NdtCell* cells[27];
+  // A floor point: its own voxel holds a flat Gaussian whose thin axis is z.
+  const Eigen::Vector4d p(0.45, 0.45, 0.23, 1.0);  // the room's floor is at z = 0.23
+  ASSERT_EQ(grid.neighbors(p, NdtNeighborhood::kDirect1, cells), 1u);
+  EXPECT_NEAR(cells[0]->mean.z(), 0.23, 1e-9);
+  EXPECT_GT(cells[0]->inverse_covariance(2, 2), 50.0 * cells[0]->inverse_covariance(0, 0));
+  EXPECT_GE(grid.neighbors(p, NdtNeighborhood::kDirect7, cells), 3u);
+  EXPECT_GE(grid.neighbors(p, NdtNeighborhood::kDirect27, cells), grid.neighbors(p, NdtNeighborhood::kDirect7, cells));
+  EXPECT_EQ(grid.neighbors(Eigen::Vector4d(100, 100, 100, 1), NdtNeighborhood::kDirect27, cells), 0u);
+  EXPECT_THROW((NdtGrid(c, NdtGridOptions{0.0, 6, 0.01})), std::invalid_argument);
+}
+
+TEST(Target, BuildsRequestedStructuresAndDropsNonFinitePoints) {
+  PointCloud c = test::room(0.2);
+  const std::size_t n = c.size();
+  c.points.emplace_back(std::nan(""), 0.0, 0.0, 1.0);
+  TargetOptions options;
+  options.normals_and_covariances = true;
+  options.ndt_resolutions = {1.0, 0.5};
+  options.num_threads = 2;
+  const Target t(std::move(c), options);
+  EXPECT_EQ(t.size(), n);
+  EXPECT_EQ(t.droppedNonFinite(), 1u);
+  EXPECT_TRUE(t.hasNormals() && t.hasCovariances());
+  EXPECT_FALSE(t.neighborGraph().empty());
+  EXPECT_NE(t.ndtGrid(1.0), nullptr);
+  EXPECT_NE(t.ndtGrid(0.5), nullptr);
+  EXPECT_EQ(t.ndtGrid(2.0), nullptr);
+  // Points are stored in the tree's order: the tree's answers index the stored cloud.
+  Neighbor nn;
+  ASSERT_TRUE(t.tree().nearest(t.cloud().points[42], 1e-6, &nn));
+  EXPECT_EQ(nn.index, 42u);
+}
+
+}  // namespace
+}  // namespace rigcal::registration

@@ -1,0 +1,114 @@
+#include "rigcal/registration/nearest_neighbors.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "rigcal/registration/covariance.hpp"
+#include "scenes.hpp"
+
+namespace rigcal::registration {
+namespace {
+
+std::vector<Eigen::Vector4d> randomPoints(std::size_t n, double scale, Eigen::Vector3d offset, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-scale, scale);
+  std::vector<Eigen::Vector4d> pts(n);
+  for (auto& p : pts) p << offset + Eigen::Vector3d(u(rng), u(rng), u(rng) * 0.2), 1.0;
+  return pts;
+}
+
+// Brute-force sorted squared distances (the reference the tree must reproduce).
+std::vector<double> bruteForce(const std::vector<Eigen::Vector4d>& pts, const Eigen::Vector4d& q) {
+  std::vector<double> d;
+  for (const auto& p : pts) d.push_back((p - q).head<3>().squaredNorm());
+  std::sort(d.begin(), d.end());
+  return d;
+}
+
+class KdTreeTest : public ::testing::TestWithParam<std::size_t> {};
+
+TEST_P(KdTreeTest, MatchesBruteForce) {
+  // Far from the origin (UTM-like) on purpose: the tree stores float offsets from the cloud's centre.
+  const Eigen::Vector3d offset(4.5e5, 5.4e6, 100.0);
+  const auto pts = randomPoints(3000, 20.0, offset, 1);
+  KdTreeOptions options;
+  options.leaf_size = GetParam();
+  const KdTree tree(pts, options);
+  ASSERT_EQ(tree.size(), pts.size());
+  const auto queries = randomPoints(200, 25.0, offset, 2);
+  for (const auto& q : queries) {
+    const auto ref = bruteForce(pts, q);
+    Neighbor nn;
+    ASSERT_TRUE(tree.nearest(q, 1e30, &nn));
+    EXPECT_NEAR(nn.sq_distance, ref[0], 1e-3 * (1.0 + ref[0]));
+    EXPECT_NEAR((pts[nn.index] - q).head<3>().squaredNorm(), ref[0], 1e-3 * (1.0 + ref[0]));
+    Neighbor k[8];
+    ASSERT_EQ(tree.knn(q, 8, k), 8u);
+    for (int i = 0; i < 8; ++i) EXPECT_NEAR(k[i].sq_distance, ref[i], 1e-3 * (1.0 + ref[i]));
+    // Bounded searches: nothing beyond the radius, everything inside it.
+    if (ref[4] - ref[3] > 1e-3 * ref[4]) {  // a radius clearly between the 4th and 5th
+      EXPECT_EQ(tree.knn(q, 8, k, 0.5 * (ref[3] + ref[4])), 4u);
+    }
+    const bool found = tree.nearest(q, ref[0] * 0.999, &nn);
+    EXPECT_FALSE(found);
+    // Hints never change the answer.
+    const std::uint32_t hints[2] = {k[3].index, 17};
+    Neighbor h[2];
+    ASSERT_EQ(tree.knn(q, 2, h, 1e30, hints), 2u);
+    EXPECT_NEAR(h[0].sq_distance, ref[0], 1e-3 * (1.0 + ref[0]));
+    EXPECT_NEAR(h[1].sq_distance, ref[1], 1e-3 * (1.0 + ref[1]));
+    ASSERT_TRUE(tree.nearest(q, 1e30, &nn, 1234));
+    EXPECT_NEAR(nn.sq_distance, ref[0], 1e-3 * (1.0 + ref[0]));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(LeafSizes, KdTreeTest, ::testing::Values(1u, 5u, 12u, 64u));
+
+TEST(KdTree, EmptyTinyAndDuplicates) {
+  const KdTree empty;
+  Neighbor nn;
+  EXPECT_FALSE(empty.nearest(Eigen::Vector4d(0, 0, 0, 1), 1e30, &nn));
+  Neighbor k[4];
+  EXPECT_EQ(empty.knn(Eigen::Vector4d(0, 0, 0, 1), 4, k), 0u);
+
+  std::vector<Eigen::Vector4d> same(100, Eigen::Vector4d(1, 2, 3, 1));
+  const KdTree dup(same);
+  EXPECT_EQ(dup.knn(Eigen::Vector4d(1, 2, 3, 1), 4, k), 4u);
+  EXPECT_EQ(k[3].sq_distance, 0.0F);
+
+  const std::vector<Eigen::Vector4d> one{Eigen::Vector4d(1, 1, 1, 1)};
+  const KdTree single(one);
+  EXPECT_EQ(single.knn(Eigen::Vector4d(0, 0, 0, 1), 4, k), 1u);
+}
+
+TEST(KdTree, ParallelBuildGivesTheSameTree) {
+  const auto pts = randomPoints(5000, 10.0, Eigen::Vector3d::Zero(), 3);
+  KdTreeOptions two;
+  two.num_threads = 2;
+  const KdTree a(pts), b(pts, two);
+  EXPECT_EQ(a.leafOrder(), b.leafOrder());
+}
+
+TEST(NeighborGraph, RadiusBoundsEveryUnlistedPoint) {
+  PointCloud cloud;
+  cloud.points = randomPoints(2000, 5.0, Eigen::Vector3d::Zero(), 4);
+  const KdTree tree(cloud.points);
+  NeighborGraph graph;
+  CovarianceOptions options;
+  options.num_neighbors = 12;
+  estimateCovariances(cloud, tree, options, &graph, 8);
+  ASSERT_EQ(graph.degree, 8u);
+  for (std::size_t j = 0; j < cloud.size(); j += 37) {
+    const auto listed = graph.of(j);
+    for (std::size_t k = 0; k < cloud.size(); ++k) {
+      if (k == j || std::find(listed.begin(), listed.end(), k) != listed.end()) continue;
+      EXPECT_GE((cloud.points[k] - cloud.points[j]).norm(), graph.radius[j] - 1e-5);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rigcal::registration
