@@ -12,6 +12,8 @@
 // Usage: shm_ring_bench [--latency-scans N] [--period-us P] [--throughput-scans N] [--fifo PRIO]
 //   --fifo PRIO runs writer, reader and the memcpy baseline under SCHED_FIFO (needs CAP_SYS_NICE): on a
 //   machine busy with other work it measures the ring rather than the queue for the CPU.
+// The latency table is printed twice: with the default idle states and with the CPU wake-up latency limit
+// held at 0 (/dev/cpu_dma_latency, see rigcal/core/cpu_latency_request.hpp), when this process may hold it.
 #include <sched.h>
 #include <unistd.h>
 
@@ -21,10 +23,12 @@
 #include <cstring>
 #include <ctime>
 #include <map>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "rigcal/core/cpu_latency_request.hpp"
 #include "rigcal/shm/liveness.hpp"
 #include "rigcal/shm/ring_segment.hpp"
 #include "rigcal/shm/scan_ring_reader.hpp"
@@ -222,16 +226,29 @@ int runParent(const std::string& self, const Args& a) {
   }
   std::printf("shm_ring_bench  cpus=%ld  scheduling %s  loadavg %s", ::sysconf(_SC_NPROCESSORS_ONLN),
               fifo > 0 ? ("SCHED_FIFO " + std::to_string(fifo)).c_str() : "SCHED_OTHER", load);
-  std::printf("latency, blocking futex wake-up, %lld scans, one every %lld us (microseconds)\n", lat_scans, period_us);
-  std::printf("  %-8s %-9s %-7s %s\n", "points", "payload", "cores", "result");
-  for (std::uint32_t points : {1'000u, 65'536u, 240'000u}) {
-    for (const auto& [wc, rc] : {std::pair{0, 1}, std::pair{0, 0}}) {
-      const std::string args = "--mode latency --points " + std::to_string(points) + " --scans " +
-                               std::to_string(lat_scans) + " --period-us " + std::to_string(period_us);
-      const auto [wline, rline] = runPair(self, args, wc, rc, fifo);
-      char payload[32];
-      std::snprintf(payload, sizeof payload, "%.2f MB", static_cast<double>(payloadBytes(points)) / 1e6);
-      std::printf("  %-8u %-9s %d -> %d   %s", points, payload, wc, rc, rline.c_str());
+  // Twice: with the kernel's default idle states, and with the CPU wake-up latency limit held at 0 (what
+  // `rigcal driver --low-latency` does): the difference is the idle core's wake-up, not the ring.
+  for (const bool low_latency : {false, true}) {
+    std::optional<CpuLatencyRequest> request;
+    if (low_latency) {
+      request.emplace(0);
+      if (!request->active()) {
+        std::printf("latency with cpu_dma_latency=0: not measured (%s)\n", request->error().c_str());
+        continue;
+      }
+    }
+    std::printf("latency, blocking futex wake-up, %s, %lld scans, one every %lld us (microseconds)\n",
+                low_latency ? "cpu_dma_latency held at 0" : "default idle states", lat_scans, period_us);
+    std::printf("  %-8s %-9s %-7s %s\n", "points", "payload", "cores", "result");
+    for (std::uint32_t points : {1'000u, 65'536u, 240'000u}) {
+      for (const auto& [wc, rc] : {std::pair{0, 1}, std::pair{0, 0}}) {
+        const std::string args = "--mode latency --points " + std::to_string(points) + " --scans " +
+                                 std::to_string(lat_scans) + " --period-us " + std::to_string(period_us);
+        const auto [wline, rline] = runPair(self, args, wc, rc, fifo);
+        char payload[32];
+        std::snprintf(payload, sizeof payload, "%.2f MB", static_cast<double>(payloadBytes(points)) / 1e6);
+        std::printf("  %-8u %-9s %d -> %d   %s", points, payload, wc, rc, rline.c_str());
+      }
     }
   }
   constexpr std::uint32_t kVls128 = 240'000;
@@ -263,8 +280,13 @@ int runParent(const std::string& self, const Args& a) {
 
 int main(int argc, char** argv) {
   Args a;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (std::strncmp(argv[i], "--", 2) == 0) a[argv[i] + 2] = argv[i + 1];
+  for (int i = 1; i < argc; i += 2) {
+    if (std::strncmp(argv[i], "--", 2) != 0 || i + 1 >= argc) {
+      std::fprintf(stderr, "shm_ring_bench: '%s' needs a value: --option VALUE (see the comment at the top)\n",
+                   argv[i]);
+      return 2;
+    }
+    a[argv[i] + 2] = argv[i + 1];
   }
   try {
     const auto role = a.find("role");
