@@ -19,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Short drives keep the tests fast; sanitizer builds shorter still.
-constexpr double kDriveSeconds = RIGCAL_SANITIZED ? 0.25 : 0.6;
+constexpr double kDriveSeconds = RIGCAL_SANITIZED ? 0.15 : 0.6;
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
