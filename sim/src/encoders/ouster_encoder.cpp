@@ -4,7 +4,8 @@
 //   16 columns: u64 timestamp (ns, the sensor's PTP clock), u16 measurement_id, u16 status (1 = valid),
 //     then one 12-byte pixel per beam row (staggered, as the sensor sends them): u32 whose low 19 bits
 //     are the range in mm, u8 reflectivity, u8 0, u16 signal, u16 near_ir, u16 0
-//   packet footer 32: zero (no CRC before firmware 3.1)
+//   packet footer 32: zero but for the last 8 bytes, which firmware 2.3–3.0 fills with the placeholder
+//     DE C0 00 00 EF BE AD DE where 3.1 and later put a CRC-64 (the metadata says v2.5.0)
 // Packets hold measurement ids 16k..16k+15 of one frame. A packet the capture only partly covers
 // (start, end, a sensor outage) is sent with its missing columns marked invalid, as the sensor marks
 // columns outside its column window.
@@ -63,6 +64,8 @@ class OusterEncoder final : public PacketEncoder {
     // packet by its first column's id).
     const int first_id = int(floorModNs(firing.sequence, model_.columns_per_frame)) / kColumnsPerPacket * kColumnsPerPacket;
     for (int c = 0; c < kColumnsPerPacket; ++c) putU16le(column(c) + 8, std::uint32_t(first_id + c));
+    static constexpr std::uint8_t kFooterPlaceholder[8] = {0xDE, 0xC0, 0x00, 0x00, 0xEF, 0xBE, 0xAD, 0xDE};
+    std::memcpy(packet_.data() + packet_size_ - 8, kFooterPlaceholder, 8);
   }
 
   [[nodiscard]] std::uint8_t* column(int c) { return packet_.data() + kPacketHeader + std::size_t(c) * column_size_; }
