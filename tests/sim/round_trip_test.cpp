@@ -71,8 +71,10 @@ TEST_P(RoundTrip, DecodersGiveBackTheSimulatedPointsWithinQuantisation) {
   EXPECT_EQ(r.matched, r.expected) << "every simulated return in the decoded span came back";
   EXPECT_LE(r.max_excess_m, 0.0) << "largest error " << r.max_error_m << " m";
   EXPECT_LE(r.max_time_error_ns, 1'000) << "packet timestamps resolve at least 1 µs";
+  EXPECT_LT(std::abs(r.mean_azimuth_error_deg), 0.002) << "no azimuth bias";
   std::cout << c.model << ": " << r.decoded << " points in " << r.scans << " sweeps, largest error "
-            << r.max_error_m * 1000 << " mm, largest time error " << r.max_time_error_ns << " ns\n";
+            << r.max_error_m * 1000 << " mm, largest time error " << r.max_time_error_ns
+            << " ns, mean azimuth error " << r.mean_azimuth_error_deg << "°\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, RoundTrip,

@@ -44,6 +44,7 @@ struct SensorRoundTrip {
   double max_error_m = 0;     // largest |decoded − simulated| over matched points
   double max_excess_m = 0;    // largest error beyond the model's quantisation bound
   TimeNs max_time_error_ns = 0;
+  double mean_azimuth_error_deg = 0;  // signed, over matched points: a bias would be a format error
   std::uint64_t malformed = 0, lost = 0, scans = 0;
   std::string last_error;
 };
@@ -85,6 +86,8 @@ inline SensorRoundTrip decodeAndCompare(const Simulation& sim, std::size_t index
   const auto& firings = rec.firings;
   TimeNs first = std::numeric_limits<TimeNs>::max(), last = std::numeric_limits<TimeNs>::min();
   std::vector<char> seen(rec.returns.size(), 0);
+  double azimuth_error_sum = 0;
+  std::size_t azimuth_errors = 0;
   for (const Scan& scan : scans) {
     for (std::size_t i = 0; i < scan.size(); ++i) {
       ++r.decoded;
@@ -105,11 +108,19 @@ inline SensorRoundTrip decodeAndCompare(const Simulation& sim, std::size_t index
       r.max_error_m = std::max(r.max_error_m, e);
       r.max_excess_m = std::max(r.max_excess_m, e - quantisationBound(model, rec.returns[k].range_m, azimuth_resolution_deg));
       r.max_time_error_ns = std::max(r.max_time_error_ns, dt);
+      const Eigen::Vector3f& q = rec.points[k];
+      if (std::hypot(q.x(), q.y()) > 2.0f) {
+        double d = std::atan2(-double(p.y()), double(p.x())) - std::atan2(-double(q.y()), double(q.x()));
+        d = std::remainder(d, 2 * M_PI);
+        azimuth_error_sum += d * 180.0 / M_PI;
+        ++azimuth_errors;
+      }
       first = std::min(first, it->sensor_time_ns);
       last = std::max(last, it->sensor_time_ns);
       ++r.matched;
     }
   }
+  if (azimuth_errors) r.mean_azimuth_error_deg = azimuth_error_sum / double(azimuth_errors);
   for (std::size_t f = 0; f < firings.size(); ++f) {
     if (firings[f].sensor_time_ns < first || firings[f].sensor_time_ns > last) continue;
     for (std::size_t b = 0; b < rec.beams; ++b) r.expected += rec.returns[f * rec.beams + b].valid;
