@@ -127,6 +127,28 @@ TEST(RoundTripCapture, AnOutageIsSeenAsLostPacketsByEveryVendor) {
   }
 }
 
+// The Ouster LEGACY profile (scenario `udp_profile: LEGACY`): the metadata says so and the decoder reads
+// the packets back just as exactly.
+TEST(RoundTripCapture, OusterLegacyProfile) {
+  Scenario sc = test::movingLidar("OS1-64", 8.0, 10.0, 0.02, 0.02, kDriveSeconds + 0.2);
+  sc.sensors[0].ouster_legacy = true;
+  const Simulation sim(sc);
+  rigcal::test::TempDir dir;
+  const Generated g = generate(sim, dir.path(), fromSeconds(kDriveSeconds));
+  const test::SensorRoundTrip r =
+      test::decodeAndCompare(sim, 0, dir.path(), dir / "recording.pcap", g.recorder->sensors[0], 0.001);
+  EXPECT_EQ(r.malformed, 0u) << r.last_error;
+  EXPECT_EQ(r.lost, 0u);
+  EXPECT_GT(r.decoded, 1000u);
+  EXPECT_EQ(r.matched, r.decoded);
+  EXPECT_EQ(r.matched, r.expected);
+  EXPECT_LE(r.max_excess_m, 0.0) << "largest error " << r.max_error_m << " m";
+  drivers::PcapSource source(dir / "recording.pcap");
+  const auto p = source.next();
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->payload.size(), 16u * (16 + 64 * 12 + 4)) << "LEGACY: no packet header or footer";
+}
+
 // The street preset (VLS-128, VLP-16, OS1-64, PandarXT32 with clock offsets and scan phases): every
 // datagram comes from the address and port of exactly one sensor, in that sensor's packet size, and
 // each sensor's decoder gives back its simulated points; truth.yaml composes.

@@ -68,6 +68,22 @@ TEST(Scenario, MistakesAreReportedWithTheirPosition) {
   EXPECT_THROW(loadScenario("no-such-preset"), ScenarioError);
 }
 
+TEST(Scenario, OusterUdpProfile) {
+  const std::string base = "scenario: p\nrig:\n  mapping_lidar: a\n  sensors:\n"
+                           "    - {name: a, model: MODEL, address: 10.0.0.2, port: 7502, extrinsic: {z: 2}, udp_profile: PROFILE}\n"
+                           "scene: {layout: empty}\ntrajectory:\n  segments: [{type: stop, duration: 1}]\n";
+  auto text = [&](const std::string& model, const std::string& profile) {
+    std::string t = base;
+    t.replace(t.find("MODEL"), 5, model);
+    t.replace(t.find("PROFILE"), 7, profile);
+    return t;
+  };
+  EXPECT_TRUE(parseScenario(text("OS1-64", "LEGACY"), "p").sensors[0].ouster_legacy);
+  EXPECT_FALSE(parseScenario(text("OS1-128", "RNG19_RFL8_SIG16_NIR16"), "p").sensors[0].ouster_legacy);
+  EXPECT_THROW(parseScenario(text("OS1-64", "RNG15"), "p"), ScenarioError);
+  EXPECT_THROW(parseScenario(text("VLP-16", "LEGACY"), "p"), ScenarioError);
+}
+
 TEST(Scenario, LoadsAFileByPath) {
   test::TempDir dir;
   std::ofstream(dir / "mine.yaml") << "scenario: mine\nrig:\n  mapping_lidar: a\n  sensors:\n"

@@ -32,8 +32,10 @@ std::vector<Bytes> payloads(const std::filesystem::path& pcap, std::size_t count
 }
 
 /// A few packets of `model` from a short simulated drive.
-std::vector<Bytes> simulated(const std::string& model, std::size_t count) {
-  const Simulation sim(test::movingLidar(model, 5.0, 0.0, 0.02, 0.0, 0.3));
+std::vector<Bytes> simulated(const std::string& model, std::size_t count, bool ouster_legacy = false) {
+  Scenario sc = test::movingLidar(model, 5.0, 0.0, 0.02, 0.0, 0.3);
+  sc.sensors[0].ouster_legacy = ouster_legacy;
+  const Simulation sim(sc);
   rigcal::test::TempDir dir;
   SimulationOptions o;
   o.build_scans = false;
@@ -115,6 +117,26 @@ TEST(WireFormat, OusterMatchesARealRng19Packet) {
     EXPECT_EQ(u16(o, 32 + c * column + 8), u16(o, 32 + 8) + c) << "consecutive measurement ids";
   }
   for (std::size_t i = o.size() - 32; i < o.size(); ++i) EXPECT_EQ(o[i], r[i]) << "footer byte " << i;
+}
+
+TEST(WireFormat, OusterMatchesARealLegacyPacket) {
+  RIGCAL_REQUIRE_DATA(path, "ouster/OS-1-64_1024x10_fw20.pcap");
+  const auto real = payloads(path, 1, 12608), ours = simulated("OS1-64", 2, true);
+  ASSERT_EQ(real.size(), 1u);
+  ASSERT_EQ(ours.size(), 2u);
+  const Bytes &r = real[0], &o = ours[1];
+  ASSERT_EQ(o.size(), r.size()) << "LEGACY, 64 pixels, 16 columns";
+  const std::size_t column = 16 + 64 * 12 + 4;
+  auto u32 = [](const Bytes& b, std::size_t at) {
+    std::uint32_t v = 0;
+    std::memcpy(&v, b.data() + at, 4);
+    return v;
+  };
+  for (int c = 0; c < 16; ++c) {
+    EXPECT_EQ(u32(o, c * column + column - 4), u32(r, c * column + column - 4)) << "column status";
+    EXPECT_EQ(u16(o, c * column + 10), u16(o, 10)) << "one frame id per packet";
+    EXPECT_EQ(u32(o, c * column + 12) - u32(o, 12), u32(r, c * column + 12) - u32(r, 12)) << "encoder ticks";
+  }
 }
 
 }  // namespace
