@@ -149,6 +149,44 @@ TEST(RoundTripCapture, OusterLegacyProfile) {
   EXPECT_EQ(p->payload.size(), 16u * (16 + 64 * 12 + 4)) << "LEGACY: no packet header or footer";
 }
 
+// A NIC sees a packet after the sensor sent it, and the sensor sends it after the last firing it
+// carries: every datagram's capture stamp (true clock) is later than each of its points' times (sensor
+// clock − clock offset), and not by much more than the packet's own duration.
+TEST(RoundTripCapture, CaptureStampsFollowTheLastFiringOfEachPacket) {
+  const Simulation sim(loadScenario("street"));
+  rigcal::test::TempDir dir;
+  generate(sim, dir.path(), fromSeconds(RIGCAL_SANITIZED ? 0.1 : 0.25));
+  std::map<std::pair<std::uint32_t, std::uint16_t>, std::size_t> sensor_of;
+  std::vector<std::unique_ptr<drivers::PacketDecoder>> decoders;
+  for (std::size_t i = 0; i < sim.sensorCount(); ++i) {
+    const SensorSpec& s = sim.scenario().sensors[i];
+    sensor_of[{ipv4FromText(s.address), s.port}] = i;
+    drivers::DecoderConfig config;
+    config.model = s.model;
+    const std::string file = vendorFile(s, sim.model(i)).first;
+    if (sim.model(i).vendor == LidarVendor::kOuster) config.metadata = dir / file;
+    else config.calibration = dir / file;
+    decoders.push_back(drivers::makeDecoder(config));
+  }
+  drivers::PcapSource source(dir / "recording.pcap");
+  drivers::DecodedPacket decoded;
+  std::vector<std::size_t> checked(sim.sensorCount(), 0);
+  TimeNs worst_lag = 0;
+  while (auto p = source.next()) {
+    const std::size_t i = sensor_of.at({p->source.address, p->destination.port});
+    decoders[i]->decode(*p, decoded);
+    if (decoded.kind != drivers::DecodedPacket::Kind::kData || decoded.points.empty()) continue;
+    TimeNs last = decoded.points.front().time_ns;
+    for (const auto& pt : decoded.points) last = std::max(last, pt.time_ns);
+    const TimeNs last_true = last - sim.scenario().sensors[i].clock_offset_ns;
+    EXPECT_GT(p->receive_ns, last_true) << sim.scenario().sensors[i].name;
+    worst_lag = std::max(worst_lag, p->receive_ns - last_true);
+    ++checked[i];
+  }
+  for (std::size_t i = 0; i < sim.sensorCount(); ++i) EXPECT_GT(checked[i], 10u) << sim.scenario().sensors[i].name;
+  EXPECT_LT(worst_lag, 5 * kNsPerMs) << "sent soon after its last firing";
+}
+
 // The street preset (VLS-128, VLP-16, OS1-64, PandarXT32 with clock offsets and scan phases): every
 // datagram comes from the address and port of exactly one sensor, in that sensor's packet size, and
 // each sensor's decoder gives back its simulated points; truth.yaml composes.
