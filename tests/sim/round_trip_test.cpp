@@ -53,6 +53,9 @@ struct ModelCase {
   double azimuth_resolution_deg;
 };
 
+// Names the case in test listings (the default prints the struct's bytes, pointers included).
+void PrintTo(const ModelCase& c, std::ostream* os) { *os << c.model; }
+
 class RoundTrip : public ::testing::TestWithParam<ModelCase> {};
 
 TEST_P(RoundTrip, DecodersGiveBackTheSimulatedPointsWithinQuantisation) {
