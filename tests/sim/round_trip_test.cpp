@@ -109,17 +109,19 @@ Pose poseFrom(const YAML::Node& n) {
 // by time, Ouster by measurement id, Hesai by udp_sequence), nothing is malformed, and every point
 // that does come back is the simulated one.
 TEST(RoundTripCapture, AnOutageIsSeenAsLostPacketsByEveryVendor) {
+  constexpr double kOutageFrom = RIGCAL_SANITIZED ? 0.05 : 0.2;
   for (const char* model : {"VLP-16", "OS1-64", "PandarXT32"}) {
     const Scenario sc = parseScenario(std::string("scenario: outage\nseed: 4\nrig:\n  mapping_lidar: l\n  sensors:\n"
                                                   "    - {name: l, model: ") + model +
                                           ", address: 10.0.0.2, port: 2368, extrinsic: {z: 1.9}, "
-                                          "outages: [{from: 0.2, to: 0.3}]}\n"
+                                          "outages: [{from: " + std::to_string(kOutageFrom) + ", to: " +
+                                          std::to_string(kOutageFrom + 0.1) + "}]}\n"
                                           "scene: {layout: parking-lot}\ntrajectory:\n"
                                           "  start: {x: -20, y: -6, speed_kmh: 6}\n  segments: [{type: cruise, duration: 0.5}]\n",
                                       "outage");
     const Simulation sim(sc);
     rigcal::test::TempDir dir;
-    const Generated g = generate(sim, dir.path(), fromSeconds(0.45));
+    const Generated g = generate(sim, dir.path(), fromSeconds(kOutageFrom + 0.25));
     const test::SensorRoundTrip r =
         test::decodeAndCompare(sim, 0, dir.path(), dir / "recording.pcap", g.recorder->sensors[0], 0.02);
     EXPECT_EQ(r.malformed, 0u) << model << ": " << r.last_error;
