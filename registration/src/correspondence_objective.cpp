@@ -23,7 +23,13 @@ CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> p
   second_.assign(total, kNone);
   query_.assign(total, Eigen::Vector3f::Zero());
   margin_.assign(total, -1.0F);
-  if (kind == Residual::kGicp) weight_.resize(total);
+  if (kind == Residual::kGicp) {
+    weight_.resize(total);
+    source_cov_.reserve(total);
+    for (const auto& p : pairs) {
+      for (const auto& c : p.source->covariances) source_cov_.push_back(Sym3::upperOf(c));
+    }
+  }
 }
 
 // Every target point outside {c} ∪ N(c) is at least R_c from c, hence at least R_c − |q − c| from q. So
@@ -133,12 +139,10 @@ LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, con
       addRow(row, e, sys.H, sys.b);
       sys.cost += e * e;
     } else if constexpr (K == Residual::kGicp) {
-      const Eigen::Matrix3d fused =
-          tc.covariances[j].topLeftCorner<3, 3>() + rotateSymmetric(R, source.covariances[i].topLeftCorner<3, 3>());
-      const Eigen::Matrix3d W = inverseSymmetric(fused);
-      weight_[g] = W;
-      const Eigen::Vector3d u = W * r;
-      addWeighted(W, q, u, sys.H, sys.b);
+      const Sym3 w = fusedInverse(R, source_cov_[g], Sym3::load(target.covarianceUpper().data() + 6 * std::size_t{j}));
+      weight_[g] = w;
+      const Eigen::Vector3d u = w.times(r);
+      addWeighted(w.full(), q, u, sys.H, sys.b);
       sys.cost += r.dot(u);
     } else {
       p2p.add(q);
@@ -169,7 +173,7 @@ double CorrespondenceObjective::costChunk(const PairChunk& chunk, const Eigen::M
       const double e = tc.normals[j].head<3>().dot(r);
       cost += e * e;
     } else if constexpr (K == Residual::kGicp) {
-      cost += r.dot(weight_[g] * r);
+      cost += r.dot(weight_[g].times(r));
     } else {
       cost += r.squaredNorm();
     }

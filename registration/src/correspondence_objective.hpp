@@ -5,6 +5,7 @@
 #include <span>
 #include <vector>
 
+#include "kernels.hpp"
 #include "solver.hpp"
 
 namespace rigcal::registration::detail {
@@ -48,7 +49,8 @@ class CorrespondenceObjective final : public Objective {
   std::vector<std::uint32_t> second_;   // the second nearest at the last search (a search hint), or kNone
   std::vector<Eigen::Vector3f> query_;  // where the last tree search for it ran
   std::vector<float> margin_;           // how far it may move from there keeping the match (m)
-  std::vector<Eigen::Matrix3d> weight_; // GICP: (C_t + R·C_s·Rᵀ)⁻¹ at the last linearisation
+  std::vector<Sym3> weight_;            // GICP: (C_t + R·C_s·Rᵀ)⁻¹ at the last linearisation
+  std::vector<Sym3> source_cov_;        // GICP: the sources' covariances, compact, concatenated
 };
 
 }  // namespace rigcal::registration::detail

@@ -14,6 +14,14 @@ RegistrationResult alignGicp(const Target& target, const PointCloud& source, con
   if (bad.empty() && !target.hasCovariances()) {
     bad = "target has no covariances (build it with normals_and_covariances)";
   }
+  if (bad.empty() && source.hasCovariances()) {
+    for (const auto& c : source.covariances) {
+      if (!c.allFinite()) {
+        bad = "source covariances are not finite (re-estimate them with estimateCovariances)";
+        break;
+      }
+    }
+  }
   if (!bad.empty()) return detail::invalid(guess, std::string(kName) + ": " + bad, params.max_correspondence_distance);
   std::optional<PointCloud> with_covariances;
   if (!source.hasCovariances()) {

@@ -29,6 +29,13 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
       out.status = stopStatus(deadline);
       return out;
     }
+    if (!sys->H.allFinite() || !sys->b.allFinite() || !std::isfinite(sys->cost)) {
+      // Only non-finite attributes can get here (positions are checked up front); never call that converged.
+      out.status = Status::kInvalidInput;
+      out.reason = format("non-finite linear system at iteration %.0f (non-finite normals, covariances or NDT cells?)",
+                          it + 1.0);
+      return out;
+    }
     out.linearized = true;
     out.T_linearized = out.T;
     out.last = *sys;

@@ -51,6 +51,12 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
       estimateCovariances(scratch, tree_, cov, &graph_, options.neighbor_graph_degree);
     }
   }
+  if (cloud_.hasCovariances()) {
+    covariance_upper_.reserve(6 * cloud_.size());
+    for (const Eigen::Matrix4d& c : cloud_.covariances) {
+      covariance_upper_.insert(covariance_upper_.end(), {c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2)});
+    }
+  }
   for (const double resolution : options.ndt_resolutions) {
     if (ndtGrid(resolution) != nullptr) continue;
     NdtGridOptions ndt = options.ndt;

@@ -87,6 +87,19 @@ TEST(Target, BuildsRequestedStructuresAndDropsNonFinitePoints) {
   Neighbor nn;
   ASSERT_TRUE(t.tree().nearest(t.cloud().points[42], 1e-6, &nn));
   EXPECT_EQ(nn.index, 42u);
+  // The compact copy GICP reads is each stored covariance's upper triangle, in the same order.
+  ASSERT_EQ(t.covarianceUpper().size(), 6 * t.size());
+  for (const std::size_t i : {std::size_t{0}, std::size_t{42}, t.size() - 1}) {
+    const Eigen::Matrix4d& C = t.cloud().covariances[i];
+    const double* u = t.covarianceUpper().data() + 6 * i;
+    EXPECT_EQ(u[0], C(0, 0));
+    EXPECT_EQ(u[1], C(0, 1));
+    EXPECT_EQ(u[2], C(0, 2));
+    EXPECT_EQ(u[3], C(1, 1));
+    EXPECT_EQ(u[4], C(1, 2));
+    EXPECT_EQ(u[5], C(2, 2));
+  }
+  EXPECT_TRUE(Target(test::room(0.2)).covarianceUpper().empty());
 }
 
 }  // namespace

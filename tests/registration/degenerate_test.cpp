@@ -143,6 +143,16 @@ TEST(InvalidInput, MissingTargetStructuresAndBadParameters) {
   EXPECT_EQ(alignBatchedIcp(null_pair, Pose::Identity()).status, Status::kInvalidInput);
 }
 
+TEST(InvalidInput, NonFiniteSourceCovariancesAreRefusedNotConverged) {
+  const Target target(test::room(0.25), test::fullTarget());
+  PointCloud src = withCovariances(test::room(0.5));
+  src.covariances[5](1, 1) = std::numeric_limits<double>::quiet_NaN();
+  const RegistrationResult r = test::run(Method::kGicp, target, src, Pose::Identity());
+  EXPECT_EQ(r.status, Status::kInvalidInput);
+  EXPECT_NE(r.reason.find("covariances are not finite"), std::string::npos) << r.reason;
+  expectWellFormed(r);
+}
+
 TEST(InvalidInput, GicpEstimatesMissingSourceCovariances) {
   const Target target(test::room(0.1), test::fullTarget());
   const PointCloud bare_source = test::movedCopy(test::room(0.1), test::knownTransform(), 0.003, 3, 1);

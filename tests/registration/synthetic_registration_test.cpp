@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <string>
 #include <thread>
 
 #include "methods.hpp"
@@ -131,6 +132,45 @@ TEST(Deadline, CancelTokenStopsARegistration) {
   canceller.join();
   EXPECT_EQ(r.status, Status::kCancelled) << r.reason;
   EXPECT_TRUE(r.T_target_source.matrix().allFinite());
+}
+
+TEST(NdtParameters, StepSizeCapsEachUpdate) {
+  // Upstream's step_size bounds every update's (metres, radians) norm: three capped steps from the
+  // identity cannot get further than three step sizes, while the default step reaches the truth.
+  const RoomPair& p = roomPair();
+  NdtParams capped;
+  capped.step_size = 0.02;
+  capped.max_iterations = 3;
+  const RegistrationResult r = alignNdt(p.target, p.source, Pose::Identity(), capped);
+  EXPECT_EQ(r.status, Status::kMaxIterations) << r.reason;
+  EXPECT_GT(r.T_target_source.translation().norm(), 0.01);  // it did move
+  EXPECT_LE(r.T_target_source.translation().norm(), 3 * 0.02 * 1.01);
+  EXPECT_LE(rotationAngle(r.T_target_source), 3 * 0.02 * 1.01);
+  const RegistrationResult full = alignNdt(p.target, p.source, Pose::Identity(), NdtParams{});
+  EXPECT_EQ(full.status, Status::kConverged) << full.reason;
+  EXPECT_LT(test::translationError(full.T_target_source, p.truth), 2e-3);
+}
+
+TEST(NdtParameters, EachResolutionUsesItsOwnGridOfOneSharedTarget) {
+  const RoomPair& p = roomPair();
+  TargetOptions options;
+  options.ndt_resolutions = {0.5, 1.0, 2.0};
+  const Target target(test::room(0.1), options);
+  ASSERT_NE(target.ndtGrid(0.5), nullptr);
+  EXPECT_GT(target.ndtGrid(0.5)->size(), target.ndtGrid(2.0)->size());
+  for (const double resolution : options.ndt_resolutions) {
+    NdtParams params;
+    params.resolution = resolution;
+    const RegistrationResult r = alignNdt(target, p.source, Pose::Identity(), params);
+    EXPECT_EQ(r.status, Status::kConverged) << resolution << ": " << r.reason;
+    // Coarser cells blur the room's corners: the bias grows with the cell (8 mm at 2 m here).
+    EXPECT_LT(test::translationError(r.T_target_source, p.truth), 5e-3 * resolution) << resolution;
+  }
+  NdtParams missing;
+  missing.resolution = 0.75;
+  const RegistrationResult r = alignNdt(target, p.source, Pose::Identity(), missing);
+  EXPECT_EQ(r.status, Status::kInvalidInput);
+  EXPECT_NE(r.reason.find("0.75"), std::string::npos) << r.reason;
 }
 
 TEST(BatchedIcp, OneTransformForSeveralPairs) {
