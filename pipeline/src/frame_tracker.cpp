@@ -121,11 +121,13 @@ std::optional<std::string> FrameTracker::keyframeLostReason(const MappingFrame& 
         return "direction changed " + std::to_string(angle) + "° between keyframes";
     }
   }
-  // Frames between the two keyframes must lie on their interpolation.
-  for (std::size_t i = keyframes_.back() + 1; i < frames_.size(); ++i) {
+  // Frames between the two keyframes must lie on their interpolation. Interpolated by path length, not
+  // time: by time, every start from a stop (the speed changes between the keyframes) would be "lost".
+  const double span = candidate.path_length - kf.path_length;
+  for (std::size_t i = keyframes_.back() + 1; i < frames_.size() && span > 0; ++i) {
     const MappingFrame& mid = frames_[i];
-    const Pose expected = interpolateAt(kf.stamp_ns, kf.T_map_lidar, candidate.stamp_ns,
-                                        candidate.T_map_lidar, mid.stamp_ns);
+    const Pose expected = interpolateLerpSlerp(kf.T_map_lidar, candidate.T_map_lidar,
+                                               (mid.path_length - kf.path_length) / span);
     const double error = (expected.translation() - mid.T_map_lidar.translation()).norm();
     if (error > params_.lost_frame_interpolation_error)
       return "frame " + std::to_string(mid.sequence) + " is " + std::to_string(error) +
