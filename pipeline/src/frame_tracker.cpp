@@ -115,7 +115,9 @@ std::optional<std::string> FrameTracker::keyframeLostReason(const MappingFrame& 
     const MappingFrame& kf_prev = frames_[keyframes_[keyframes_.size() - 2]];
     const Eigen::Vector3d d1 = kf.T_map_lidar.translation() - kf_prev.T_map_lidar.translation();
     const Eigen::Vector3d d2 = candidate.T_map_lidar.translation() - kf.T_map_lidar.translation();
-    if (d1.norm() > 1e-6 && d2.norm() > 1e-6) {
+    // Only over real travel: between stopped keyframes the "direction" is registration noise.
+    const double min_travel = 0.5 * params_.new_keyframe_min_distance;
+    if (d1.norm() > min_travel && d2.norm() > min_travel) {
       const double angle = rad2deg(std::acos(std::clamp(d1.normalized().dot(d2.normalized()), -1.0, 1.0)));
       if (angle > params_.lost_frame_max_angle_diff)
         return "direction changed " + std::to_string(angle) + "° between keyframes";

@@ -1,5 +1,6 @@
 #include "rigcal/pipeline/mapper.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <stdexcept>
@@ -56,8 +57,17 @@ struct Mapper::Impl {
   std::deque<Keyframe> local;          // the local map's keyframes, oldest first
   std::vector<reg::PointCloud> all_keyframes;  // every keyframe's cloud in the map frame (for the map)
   std::shared_ptr<const reg::Target> target;
-  // The last registered frame (stored or not) and the one before: the motion for deskewing.
+  // The last two good registrations (mid-sweep poses and times): the motion model.
   bool have_last = false, have_prev = false, last_failed = false;
+  FrameKind last_kind = FrameKind::kKeyframe;
+  int failures_in_a_row = 0;
+  static constexpr int kRestartAfterFailures = 2;
+
+  static TimeNs midSweep(const Scan& scan) {
+    std::uint32_t sweep = 0;
+    for (std::uint32_t o : scan.offset_ns) sweep = std::max(sweep, o);
+    return scan.stamp_ns + TimeNs(sweep / 2);
+  }
   TimeNs last_stamp = 0, prev_stamp = 0;
   Pose last_pose = Pose::Identity(), prev_pose = Pose::Identity();
 
@@ -148,10 +158,17 @@ struct Mapper::Impl {
     if (!target) {  // the first frame defines the map
       out.registration = {"first", 0, 1.0, 0.0, true};
     } else {
-      // After a failed registration the tracker would restart from the failed frame's pose; the motion
-      // of the last two good registrations is the better guess.
-      const Pose guess = last_failed && have_prev ? extrapolate(scan.stamp_ns) : tracker.predict(scan.stamp_ns);
-      deskew(deskewed, motion(scan.stamp_ns));
+      // Deskew to the middle of the sweep and register there. The motion model follows these mid-sweep
+      // poses only (pure registration results): were it fed the poses at the first point, which are
+      // extrapolated with the model's own velocity, a velocity error would come back amplified (the loop
+      // oscillates and grows while standing still).
+      const TimeNs mid = midSweep(scan);
+      const SensorMotion T_mid_sensor = motion(mid);
+      // Upstream: constant velocity, or the last pose after a stopped or lost frame. After a failed
+      // registration the motion of the last two good ones is still the best guess.
+      const bool hold = (last_kind == FrameKind::kStopped || last_kind == FrameKind::kStoppedKeyframe) && !last_failed;
+      const Pose guess = hold ? last_pose : extrapolate(mid);
+      deskew(deskewed, T_mid_sensor);
       reg::PointCloud source = reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_input);
       if (!use_ndt) {  // once, shared by the retries
         reg::CovarianceOptions co;
@@ -170,30 +187,48 @@ struct Mapper::Impl {
       out.registration = {std::string(reg::toString(r.status)), r.iterations, r.inlier_ratio, r.rmse,
                           converged && fit};
       if (converged && !fit) out.registration.status += ", inlier ratio below " + std::to_string(kMinInlierRatio);
-      pose = out.registration.ok ? r.T_target_source : guess;
-      if (out.registration.ok && have_last && scan.stamp_ns > last_stamp) {
-        // Refine once: the motion from the last pose to the registered one replaces the prediction.
+      const Pose mid_pose = out.registration.ok ? r.T_target_source : guess;
+      if (out.registration.ok && have_last && mid > last_stamp) {
+        // Refine once: the motion from the last registration to this one replaces the prediction; the
+        // frame's pose and stored cloud are at its stamp (first point).
+        const Pose step = last_pose.inverse() * mid_pose;
+        pose = mid_pose * constantVelocity(step, mid - last_stamp, mid)(scan.stamp_ns);
         deskewed = scan;
-        deskew(deskewed, constantVelocity(last_pose.inverse() * pose, scan.stamp_ns - last_stamp, scan.stamp_ns));
+        deskew(deskewed, constantVelocity(step, mid - last_stamp, scan.stamp_ns));
+      } else {
+        pose = mid_pose * T_mid_sensor(scan.stamp_ns);
+      }
+      if (out.registration.ok) {
+        prev_pose = last_pose;
+        prev_stamp = last_stamp;
+        have_prev = have_last;
+        last_pose = mid_pose;
+        last_stamp = mid;
+        have_last = true;
       }
     }
 
     out.frame = tracker.add(scan.sequence, scan.stamp_ns, pose, out.registration.ok);
     last_failed = !out.registration.ok;
-    if (out.registration.ok) {  // the motion model follows good registrations only
-      prev_pose = last_pose;
-      prev_stamp = last_stamp;
-      have_prev = have_last;
+    last_kind = out.frame.kind;
+    if (!have_last) {  // the first frame: at rest as far as anyone knows
       last_pose = pose;
-      last_stamp = scan.stamp_ns;
+      last_stamp = midSweep(scan);
       have_last = true;
     }
 
     if (out.frame.stored())
       out.cloud = std::make_shared<const Scan>(
           toScan(reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_dense_map), scan));
-    // A lost keyframe restarts the local map (upstream); a failed registration never feeds it.
+    // A lost keyframe restarts the local map (upstream); a failed registration does not feed it, unless
+    // registrations keep failing (the map was restarted from a partial sweep, or the vehicle got far off
+    // the prediction): then the map restarts from this frame at its predicted pose.
+    failures_in_a_row = out.registration.ok ? 0 : failures_in_a_row + 1;
     if (out.frame.isKeyframe() && out.registration.ok) addKeyframe(deskewed, pose, out.frame.lost || !target);
+    else if (failures_in_a_row >= kRestartAfterFailures) {
+      addKeyframe(deskewed, pose, true);
+      failures_in_a_row = 0;
+    }
     return out;
   }
 };
