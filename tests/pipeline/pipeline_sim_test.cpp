@@ -18,7 +18,7 @@ using test::runInProcess;
 using test::truthAt;
 
 // Simulating is CPU-heavy: a segment in Release, a few seconds under the sanitizers.
-constexpr double kParkingLotSeconds = RIGCAL_SANITIZED ? 5.0 : 18.0;
+constexpr double kParkingLotSeconds = RIGCAL_SANITIZED ? 5.0 : 14.0;
 
 config::Parameters& testParameters(config::RigConfig& rig) {
   auto& p = rig.parameters;
