@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -82,11 +83,15 @@ pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector
 
 int main(int argc, char** argv) {
   double seconds = 12.0;
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::strcmp(argv[i], "--seconds") == 0) seconds = std::stod(argv[i + 1]);
+  bool baseline_only = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) seconds = std::stod(argv[i + 1]);
+    if (std::strcmp(argv[i], "--baseline-only") == 0) baseline_only = true;
+  }
 
   sim::Simulation simulation(sim::loadScenario("parking-lot"));
   const fs::path dir = fs::temp_directory_path() / ("pipeline_latency_bench_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
   sim::writeRigFiles(simulation, dir);
   config::RigConfig rig = config::loadRigConfig(dir / "rig.yaml");
   fs::remove_all(dir);
@@ -101,16 +106,19 @@ int main(int argc, char** argv) {
   {
     pipeline::Mapper mapper(rig.parameters);
     pipeline::LatencyHistogram h;
+    const auto cpu0 = std::clock();
     for (const auto& s : rec.scans) {
       if (s.sensor_id != rig.roles.mapping_lidar) continue;
       const auto t0 = std::chrono::steady_clock::now();
       mapper.process(s);
       h.record(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count());
     }
-    std::printf("baseline (mapper alone, serial, compute only):\n");
+    std::printf("baseline (mapper alone, serial, compute only): %.1f ms CPU per scan\n",
+                1e3 * double(std::clock() - cpu0) / CLOCKS_PER_SEC / double(std::max<std::uint64_t>(1, h.count())));
     printStage("mapper process()", h);
   }
 
+  if (baseline_only) return 0;
   const std::vector<std::vector<std::string>> setups = {
       {"top"}, {"top", "front_left"}, {"top", "front_left", "front_right"}};
   for (const auto& sensors : setups) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <future>
 #include <stdexcept>
 
 #include "rigcal/pipeline/deskew.hpp"
@@ -44,9 +45,7 @@ Scan toScan(const reg::PointCloud& cloud, const Scan& like) {
   return s;
 }
 
-struct Keyframe {
-  reg::PointCloud cloud_in_map;  // voxelised at leaf_size_local_map
-};
+using KeyframeCloud = std::shared_ptr<const reg::PointCloud>;  // in the map frame, voxel leaf_size_local_map
 
 }  // namespace
 
@@ -54,9 +53,15 @@ struct Mapper::Impl {
   config::Parameters params;
   FrameTracker tracker;
   bool use_ndt = false;
-  std::deque<Keyframe> local;          // the local map's keyframes, oldest first
-  std::vector<reg::PointCloud> all_keyframes;  // every keyframe's cloud in the map frame (for the map)
+  std::deque<KeyframeCloud> local;     // the local map's keyframes, oldest first
+  std::vector<KeyframeCloud> all_keyframes;  // every keyframe's cloud (for the map)
   std::shared_ptr<const reg::Target> target;
+  // The local map after a new keyframe is built on another thread while registration goes on against
+  // the previous one; it is swapped in at the second scan after that keyframe (a fixed point in the
+  // scan sequence: offline runs stay deterministic), waiting for it only if it is not ready by then.
+  std::future<std::shared_ptr<const reg::Target>> pending_target;
+  int scans_since_launch = 0;
+  static constexpr int kSwapAfterScans = 2;
   // The last two good registrations (mid-sweep poses and times): the motion model.
   bool have_last = false, have_prev = false, last_failed = false;
   FrameKind last_kind = FrameKind::kKeyframe;
@@ -77,30 +82,59 @@ struct Mapper::Impl {
       throw std::invalid_argument("mapping_registrator must be gicp or ndt, got '" + p.mapping_registrator + "'");
   }
 
-  void rebuildTarget() {
+  static std::shared_ptr<const reg::Target> buildTarget(const std::vector<KeyframeCloud>& clouds,
+                                                        const config::Parameters& params, bool use_ndt) {
     reg::PointCloud merged;
-    for (const auto& k : local) merged.points.insert(merged.points.end(), k.cloud_in_map.points.begin(),
-                                                     k.cloud_in_map.points.end());
+    for (const auto& k : clouds) merged.points.insert(merged.points.end(), k->points.begin(), k->points.end());
     merged = reg::voxelDownsample(merged, params.leaf_size_local_map);
     reg::TargetOptions o;
     o.num_threads = std::max(1, params.mapper_num_threads);
     if (use_ndt) o.ndt_resolutions = {params.mapper_resolution};
     else o.normals_and_covariances = true;
-    target = std::make_shared<const reg::Target>(std::move(merged), o);
+    return std::make_shared<const reg::Target>(std::move(merged), o);
+  }
+
+  void swapInPendingTarget(bool now) {
+    if (!pending_target.valid()) return;
+    if (!now && ++scans_since_launch < kSwapAfterScans) return;
+    target = pending_target.get();
   }
 
   void addKeyframe(const Scan& deskewed, const Pose& T_map_lidar, bool restart) {
     reg::PointCloud c = reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_local_map);
-    Keyframe k{reg::transformed(c, T_map_lidar)};
-    k.cloud_in_map.clearAttributes();
+    auto k = std::make_shared<reg::PointCloud>(reg::transformed(c, T_map_lidar));
+    k->clearAttributes();
     if (restart) local.clear();
-    all_keyframes.push_back(k.cloud_in_map);
+    all_keyframes.push_back(k);
     local.push_back(std::move(k));
     while (int(local.size()) > std::max(1, params.local_map_num_keyframes)) local.pop_front();
-    rebuildTarget();
+    swapInPendingTarget(true);
+    std::vector<KeyframeCloud> clouds(local.begin(), local.end());
+    if (restart || !target) {  // the old map is no use: build it now
+      target = buildTarget(clouds, params, use_ndt);
+      return;
+    }
+    scans_since_launch = 0;
+    pending_target = std::async(std::launch::async, [clouds = std::move(clouds), p = params, ndt = use_ndt] {
+      return buildTarget(clouds, p, ndt);
+    });
   }
 
   static constexpr double kCoarseCorrespondence = 1.0;  // m
+  // A scan-to-map registration needs a few thousand well-spread points, not every voxel: beyond this the
+  // voxelised scan is thinned with a fixed stride (deterministic), which keeps the mapper within a 10 Hz
+  // budget on two shared cores at the same accuracy (see the trajectory test).
+  static constexpr std::size_t kMaxRegistrationPoints = 6000;
+
+  reg::PointCloud registrationSource(const Scan& deskewed) const {
+    reg::PointCloud v = reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_input);
+    if (v.size() <= kMaxRegistrationPoints) return v;
+    const double stride = double(v.size()) / double(kMaxRegistrationPoints);
+    reg::PointCloud thin;
+    thin.points.reserve(kMaxRegistrationPoints);
+    for (std::size_t i = 0; i < kMaxRegistrationPoints; ++i) thin.points.push_back(v.points[std::size_t(double(i) * stride)]);
+    return thin;
+  }
 
   static bool accepted(const reg::RegistrationResult& r) {
     return (r.status == reg::Status::kConverged || r.status == reg::Status::kMaxIterations) &&
@@ -153,6 +187,7 @@ struct Mapper::Impl {
     }
     out.registered = true;
 
+    swapInPendingTarget(false);
     Pose pose = Pose::Identity();
     Scan deskewed = scan;
     if (!target) {  // the first frame defines the map
@@ -169,7 +204,7 @@ struct Mapper::Impl {
       const bool hold = (last_kind == FrameKind::kStopped || last_kind == FrameKind::kStoppedKeyframe) && !last_failed;
       const Pose guess = hold ? last_pose : extrapolate(mid);
       deskew(deskewed, T_mid_sensor);
-      reg::PointCloud source = reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_input);
+      reg::PointCloud source = registrationSource(deskewed);
       if (!use_ndt) {  // once, shared by the retries
         reg::CovarianceOptions co;
         co.num_threads = std::max(1, params.mapper_num_threads);
@@ -242,8 +277,7 @@ std::size_t Mapper::localMapPoints() const { return impl_->target ? impl_->targe
 
 std::shared_ptr<const Scan> Mapper::mapCloud() const {
   reg::PointCloud merged;
-  for (const auto& k : impl_->all_keyframes)
-    merged.points.insert(merged.points.end(), k.points.begin(), k.points.end());
+  for (const auto& k : impl_->all_keyframes) merged.points.insert(merged.points.end(), k->points.begin(), k->points.end());
   Scan like;
   like.sensor_id = "map";
   if (merged.empty()) return std::make_shared<const Scan>(like);
