@@ -62,7 +62,7 @@ std::vector<std::unique_ptr<PacketEncoder>> makeEncoders(const Simulation& sim) 
   std::vector<std::unique_ptr<PacketEncoder>> out;
   for (std::size_t i = 0; i < sim.sensorCount(); ++i) {
     const SensorSpec& s = sim.scenario().sensors[i];
-    out.push_back(makePacketEncoder(sim.model(i), {s.name, s.port, false, hashKeys(sim.scenario().seed, i)}));
+    out.push_back(makePacketEncoder(sim.model(i), {s.name, s.port, false, hashKeys(sim.scenario().seed, i), s.ouster_legacy}));
   }
   return out;
 }

@@ -7,6 +7,7 @@
 
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/random.hpp"
+#include "encoders/ouster_identity.hpp"
 #include "text_format.hpp"
 
 namespace rigcal::sim {
@@ -62,7 +63,7 @@ std::string jsonList(const std::vector<double>& v, int decimals) {
 }
 
 // sensor_info in the firmware 2.x layout, with what a decoder needs: beam angles, beam origin,
-// lidar-to-sensor transform, data format (RNG19 profile, 16 columns per packet), ports.
+// lidar-to-sensor transform, data format (RNG19 or LEGACY profile, 16 columns per packet), ports.
 std::string ousterJson(const SensorSpec& s, const LidarModel& m) {
   std::vector<double> alt, az, shift;
   for (const auto& b : m.beams) {
@@ -72,6 +73,7 @@ std::string ousterJson(const SensorSpec& s, const LidarModel& m) {
   }
   const double n_mm = m.beam_origin_radius_m * 1000.0;
   const std::string line = m.name == "OS1-128" ? "OS-1-128" : "OS-1-64";
+  const char* profile = s.ouster_legacy ? "LEGACY" : "RNG19_RFL8_SIG16_NIR16";
   std::ostringstream j;
   j << "{\n";
   j << "  \"beam_intrinsics\": {\n";
@@ -80,6 +82,7 @@ std::string ousterJson(const SensorSpec& s, const LidarModel& m) {
   j << "    \"beam_to_lidar_transform\": [1, 0, 0, " << exact(n_mm) << ", 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1],\n";
   j << "    \"lidar_origin_to_beam_origin_mm\": " << exact(n_mm) << "\n";
   j << "  },\n";
+  j << "  \"calibration_status\": {\"reflectivity\": {\"timestamp\": \"\", \"valid\": false}},\n";
   j << "  \"config_params\": {\n";
   j << "    \"columns_per_packet\": 16,\n";
   j << "    \"lidar_mode\": \"" << m.columns_per_frame << "x" << exact(m.rotation_hz) << "\",\n";
@@ -87,7 +90,7 @@ std::string ousterJson(const SensorSpec& s, const LidarModel& m) {
   j << "    \"udp_port_imu\": " << s.port + 1 << ",\n";
   j << "    \"udp_port_lidar\": " << s.port << ",\n";
   j << "    \"udp_profile_imu\": \"LEGACY\",\n";
-  j << "    \"udp_profile_lidar\": \"RNG19_RFL8_SIG16_NIR16\"\n";
+  j << "    \"udp_profile_lidar\": \"" << profile << "\"\n";
   j << "  },\n";
   j << "  \"lidar_data_format\": {\n";
   j << "    \"column_window\": [0, " << m.columns_per_frame - 1 << "],\n";
@@ -96,7 +99,7 @@ std::string ousterJson(const SensorSpec& s, const LidarModel& m) {
   j << "    \"pixel_shift_by_row\": " << jsonList(shift, 0) << ",\n";
   j << "    \"pixels_per_column\": " << m.beams.size() << ",\n";
   j << "    \"udp_profile_imu\": \"LEGACY\",\n";
-  j << "    \"udp_profile_lidar\": \"RNG19_RFL8_SIG16_NIR16\"\n";
+  j << "    \"udp_profile_lidar\": \"" << profile << "\"\n";
   j << "  },\n";
   j << "  \"lidar_intrinsics\": {\n";
   j << "    \"lidar_to_sensor_transform\": [-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, " << fixed(m.beam_origin_z_m * 1000.0, 2)
@@ -105,7 +108,9 @@ std::string ousterJson(const SensorSpec& s, const LidarModel& m) {
   j << "  \"sensor_info\": {\n";
   j << "    \"build_rev\": \"v2.5.0\",\n";
   j << "    \"prod_line\": \"" << line << "\",\n";
-  j << "    \"prod_sn\": \"rigcal-sim-" << s.name << "\",\n";
+  const encoders::OusterIdentity id = encoders::ousterIdentity(s.name, s.port);
+  j << "    \"initialization_id\": " << id.init_id << ",\n";
+  j << "    \"prod_sn\": \"" << id.serial << "\",\n";
   j << "    \"status\": \"RUNNING\"\n";
   j << "  }\n";
   j << "}\n";

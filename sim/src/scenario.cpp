@@ -113,7 +113,7 @@ bool validIpv4(const std::string& s) {
 
 SensorSpec readSensor(const Reader& r, const YAML::Node& n) {
   r.map(n, "a sensor", {"name", "model", "address", "port", "extrinsic", "scan_phase_deg", "clock_offset_ms",
-                        "time_source", "outages"});
+                        "time_source", "outages", "udp_profile"});
   SensorSpec s;
   s.name = r.text(r.need(n, "name", "a sensor"), "name");
   const YAML::Node model = r.need(n, "model", "sensor '" + s.name + "'");
@@ -134,6 +134,13 @@ SensorSpec readSensor(const Reader& r, const YAML::Node& n) {
     const std::string v = r.text(ts, "time_source");
     if (v != "sensor" && v != "host") r.fail(ts, "'time_source' must be 'sensor' or 'host'");
     s.time_source_sensor = v == "sensor";
+  }
+  if (const YAML::Node profile = n["udp_profile"]) {
+    const std::string v = r.text(profile, "udp_profile");
+    if (lidarModel(s.model).vendor != LidarVendor::kOuster) r.fail(profile, "'udp_profile' is for Ouster sensors only");
+    if (v != "RNG19_RFL8_SIG16_NIR16" && v != "LEGACY")
+      r.fail(profile, "'udp_profile' must be RNG19_RFL8_SIG16_NIR16 or LEGACY");
+    s.ouster_legacy = v == "LEGACY";
   }
   if (const YAML::Node outages = n["outages"]) {
     if (!outages.IsSequence()) r.fail(outages, "'outages' must be a list of {from, to}");

@@ -39,6 +39,7 @@ struct EncoderConfig {
   std::uint16_t lidar_port = 0;       // Ouster metadata names it
   bool dual_return = false;           // single (strongest) return unless asked
   std::uint64_t seed = 0;             // for anything a real sensor randomises (e.g. initial counters)
+  bool ouster_legacy = false;         // Ouster: LEGACY profile (the metadata must say so too)
 };
 
 class PacketEncoder {

@@ -37,6 +37,7 @@ struct SensorSpec {
   TimeNs clock_offset_ns = 0;  // sensor clock = true clock + offset
   bool time_source_sensor = true;  // rig.yaml time_source: sensor (true) or host
   std::vector<Outage> outages;
+  bool ouster_legacy = false;  // Ouster: LEGACY packets instead of RNG19_RFL8_SIG16_NIR16
 };
 
 struct PoseSensorSpec {
