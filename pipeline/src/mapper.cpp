@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <chrono>
 #include <future>
 #include <stdexcept>
 
@@ -76,7 +77,9 @@ struct Mapper::Impl {
   TimeNs last_stamp = 0, prev_stamp = 0;
   Pose last_pose = Pose::Identity(), prev_pose = Pose::Identity();
 
-  explicit Impl(const config::Parameters& p) : params(p), tracker(p) {
+  bool deterministic = true;
+
+  Impl(const config::Parameters& p, bool det) : params(p), tracker(p), deterministic(det) {
     if (p.mapping_registrator == "ndt") use_ndt = true;
     else if (p.mapping_registrator != "gicp")
       throw std::invalid_argument("mapping_registrator must be gicp or ndt, got '" + p.mapping_registrator + "'");
@@ -96,7 +99,9 @@ struct Mapper::Impl {
 
   void swapInPendingTarget(bool now) {
     if (!pending_target.valid()) return;
-    if (!now && ++scans_since_launch < kSwapAfterScans) return;
+    ++scans_since_launch;
+    const bool ready = pending_target.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    if (!now && (deterministic ? scans_since_launch < kSwapAfterScans : !ready)) return;
     target = pending_target.get();
   }
 
@@ -268,7 +273,8 @@ struct Mapper::Impl {
   }
 };
 
-Mapper::Mapper(const config::Parameters& params) : impl_(std::make_unique<Impl>(params)) {}
+Mapper::Mapper(const config::Parameters& params, bool deterministic)
+    : impl_(std::make_unique<Impl>(params, deterministic)) {}
 Mapper::~Mapper() = default;
 MapperOutput Mapper::process(const Scan& scan) { return impl_->process(scan); }
 const FrameTracker& Mapper::tracker() const { return impl_->tracker; }

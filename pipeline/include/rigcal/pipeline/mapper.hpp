@@ -41,7 +41,9 @@ class Mapper {
   /// (GICP) or 1 m (NDT) of the local map.
   static constexpr double kMinInlierRatio = 0.3;
 
-  explicit Mapper(const config::Parameters& params);
+  /// `deterministic` (offline): a rebuilt local map is swapped in at a fixed scan after its keyframe,
+  /// waiting for it if needed. Otherwise (real time) it is swapped in as soon as it is ready: never waits.
+  explicit Mapper(const config::Parameters& params, bool deterministic = true);
   ~Mapper();
   Mapper(const Mapper&) = delete;
   Mapper& operator=(const Mapper&) = delete;
