@@ -139,14 +139,15 @@ struct Pipeline::Impl {
   std::atomic<bool> abort{false};
   std::atomic<bool> source_stop{false};
   std::vector<StageThread> stages;  // deskew, mapper, pairing, selector
-  std::vector<StageThread> sources;
+  std::vector<StageThread> sources;  // appended by run() under sources_mutex (stats() reads them)
+  mutable std::mutex sources_mutex;
   std::vector<std::unique_ptr<SensorDriver>> drivers;
   std::vector<int> driver_sensor;  // sensor index of each driver
   std::vector<std::unique_ptr<shm::ScanRingReader>> readers;
   std::atomic<int> sources_running{0};
   std::mutex finish_mutex;
   std::atomic<bool> finished{false};
-  std::uint64_t ring_overruns = 0;
+  std::atomic<std::uint64_t> ring_overruns{0};
 
   // Offline pcap: calibration drivers wait for the mapping driver (bounded memory, no deadlock).
   std::mutex lead_mutex;
@@ -486,6 +487,7 @@ struct Pipeline::Impl {
   }
 
   void startSources() {
+    std::lock_guard lock(sources_mutex);
     for (std::size_t d = 0; d < drivers.size(); ++d) {
       ++sources_running;
       sources.emplace_back("drv:" + sensors[std::size_t(driver_sensor[d])], options.cores, [this, d] {
@@ -526,7 +528,10 @@ struct Pipeline::Impl {
     if (finished) return;
     source_stop.store(true);
     lead_cv.notify_all();
-    for (auto& s : sources) s.join();
+    {
+      std::lock_guard sources_lock(sources_mutex);
+      for (auto& s : sources) s.join();
+    }
     for (const auto& r : readers) ring_overruns += r->stats().overruns + r->stats().torn_reads;
     endOfInput();
     for (auto& s : stages) s.join();
@@ -540,7 +545,10 @@ struct Pipeline::Impl {
       if (finished) return;
       source_stop.store(true);
       lead_cv.notify_all();
-      for (auto& s : sources) s.join();
+      {
+        std::lock_guard sources_lock(sources_mutex);
+        for (auto& s : sources) s.join();
+      }
       abort.store(true);
       for (auto* q : {&q_in, &q_map}) q->close();
       q_pose.close();
@@ -621,6 +629,7 @@ PipelineStats Pipeline::stats() const {
       if (t.name() == r->name) st.cpu_seconds = t.cpuSeconds();
     s.stages.push_back(std::move(st));
   }
+  std::lock_guard sources_lock(m.sources_mutex);
   for (const auto& t : m.sources) {
     StageStats st;
     st.name = t.name();
