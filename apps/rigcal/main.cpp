@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   addReplayCommand(app);
   addMonitorCommand(app);
   addSimCommand(app);
+  addMapCommand(app);
 
   try {
     app.parse(argc, argv);
