@@ -21,5 +21,6 @@ void addReplayCommand(CLI::App& app);
 void addMonitorCommand(CLI::App& app);
 void addSimCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
+void addCompareCommand(CLI::App& app);
 
 }  // namespace rigcal::app

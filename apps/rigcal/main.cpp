@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   addMonitorCommand(app);
   addSimCommand(app);
   addMapCommand(app);
+  addCompareCommand(app);
 
   try {
     app.parse(argc, argv);
