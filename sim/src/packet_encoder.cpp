@@ -1,10 +1,15 @@
 #include "rigcal/sim/packet_encoder.hpp"
 
+#include "encoders/encoders.hpp"
+
 namespace rigcal::sim {
 
-std::unique_ptr<PacketEncoder> makePacketEncoder(const LidarModel& /*model*/, const EncoderConfig& /*config*/) {
-  // Phase 2 adds one encoder per vendor format here (Velodyne VLP-16/VLP-32C/VLS-128, Ouster RNG19,
-  // Hesai XT32). Until then no model has one: no capture is written rather than a fake one.
+std::unique_ptr<PacketEncoder> makePacketEncoder(const LidarModel& model, const EncoderConfig& config) {
+  switch (model.vendor) {
+    case LidarVendor::kVelodyne: return encoders::makeVelodyneEncoder(model, config);
+    case LidarVendor::kOuster: return encoders::makeOusterEncoder(model, config);
+    case LidarVendor::kHesai: return encoders::makeHesaiEncoder(model, config);
+  }
   return nullptr;
 }
 

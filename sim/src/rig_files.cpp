@@ -7,6 +7,7 @@
 
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/random.hpp"
+#include "encoders/ouster_identity.hpp"
 #include "text_format.hpp"
 
 namespace rigcal::sim {
@@ -80,6 +81,7 @@ std::string ousterJson(const SensorSpec& s, const LidarModel& m) {
   j << "    \"beam_to_lidar_transform\": [1, 0, 0, " << exact(n_mm) << ", 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1],\n";
   j << "    \"lidar_origin_to_beam_origin_mm\": " << exact(n_mm) << "\n";
   j << "  },\n";
+  j << "  \"calibration_status\": {\"reflectivity\": {\"timestamp\": \"\", \"valid\": false}},\n";
   j << "  \"config_params\": {\n";
   j << "    \"columns_per_packet\": 16,\n";
   j << "    \"lidar_mode\": \"" << m.columns_per_frame << "x" << exact(m.rotation_hz) << "\",\n";
@@ -105,7 +107,9 @@ std::string ousterJson(const SensorSpec& s, const LidarModel& m) {
   j << "  \"sensor_info\": {\n";
   j << "    \"build_rev\": \"v2.5.0\",\n";
   j << "    \"prod_line\": \"" << line << "\",\n";
-  j << "    \"prod_sn\": \"rigcal-sim-" << s.name << "\",\n";
+  const encoders::OusterIdentity id = encoders::ousterIdentity(s.name, s.port);
+  j << "    \"initialization_id\": " << id.init_id << ",\n";
+  j << "    \"prod_sn\": \"" << id.serial << "\",\n";
   j << "    \"status\": \"RUNNING\"\n";
   j << "  }\n";
   j << "}\n";

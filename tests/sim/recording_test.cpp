@@ -101,7 +101,7 @@ TEST(Recording, RefusesMissingEncoders) {
   const Simulation sim(loadScenario("pose"));
   auto encoders = makeEncoders(sim);
   ASSERT_EQ(encoders.size(), 1u);
-  EXPECT_EQ(encoders[0], nullptr) << "phase 1 has no vendor encoders";
+  encoders[0].reset();  // as if its model had no encoder
   test::TempDir dir;
   EXPECT_THROW(writeRecording(sim, std::move(encoders), dir / "x.pcap", {}), std::invalid_argument);
   EXPECT_FALSE(std::filesystem::exists(dir / "x.pcap"));

@@ -88,16 +88,39 @@ std::pair<int, std::string> runRigcal(const std::string& args) {
   return {WEXITSTATUS(status), out};
 }
 
-TEST(SimCommand, WritesTruthPosesAndRigAndSaysWhyThereIsNoCapture) {
+TEST(SimCommand, WritesTruthPosesRigAndACaptureThatDecodeAndCheckConfigRead) {
   test::TempDir dir;
-  const auto [rc, out] = runRigcal("sim --scenario pose --out " + dir.path().string() + " --seed 5");
+  // Two lidars of different vendors, a short drive: rig.yaml names each one's calibration/metadata
+  // file, and `rigcal decode` / `rigcal check-config` work on the output folder as it is.
+  std::ofstream(dir / "two.yaml") << "scenario: two\nseed: 5\nrig:\n  mapping_lidar: top\n  calibration_lidars: [side]\n"
+                                     "  sensors:\n"
+                                     "    - {name: top, model: OS1-64, address: 10.5.5.87, port: 7502, extrinsic: {z: 2}}\n"
+                                     "    - {name: side, model: VLP-16, address: 10.0.0.2, port: 2368, extrinsic: {x: 1, z: 1.5}}\n"
+                                     "scene: {layout: parking-lot}\ntrajectory:\n"
+                                     "  start: {x: -20, y: -6, speed_kmh: 5}\n  segments: [{type: cruise, duration: 0.35}]\n";
+  const std::filesystem::path out_dir = dir / "o";
+  const auto [rc, out] = runRigcal("sim --scenario " + (dir / "two.yaml").string() + " --out " + out_dir.string());
   ASSERT_EQ(rc, 0) << out;
-  for (const char* f : {"truth.yaml", "poses.csv", "rig.yaml", "lidar.calibration.yaml"})
-    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
-  EXPECT_FALSE(std::filesystem::exists(dir / "recording.pcap")) << "never a fake capture";
-  EXPECT_NE(out.find("recording.pcap NOT written"), std::string::npos) << out;
-  EXPECT_NE(out.find("VLP-16"), std::string::npos) << out;
-  EXPECT_NO_THROW(config::loadRigConfig(dir / "rig.yaml"));
+  for (const char* f : {"truth.yaml", "poses.csv", "rig.yaml", "top.json", "side.calibration.yaml", "recording.pcap"})
+    EXPECT_TRUE(std::filesystem::exists(out_dir / f)) << f;
+  EXPECT_NE(out.find("datagrams"), std::string::npos) << out;
+  EXPECT_NO_THROW(config::loadRigConfig(out_dir / "rig.yaml"));
+  const auto [check_rc, check_out] = runRigcal("check-config " + (out_dir / "rig.yaml").string());
+  EXPECT_EQ(check_rc, 0) << check_out;
+  const auto [dec_rc, dec_out] =
+      runRigcal("decode " + (out_dir / "recording.pcap").string() + " --sensor OS1-64 --metadata " +
+                (out_dir / "top.json").string() + " --port 7502 --format csv --out " + (dir / "top").string());
+  EXPECT_EQ(dec_rc, 0) << dec_out;
+  const auto [dec2_rc, dec2_out] =
+      runRigcal("decode " + (out_dir / "recording.pcap").string() + " --sensor VLP-16 --calibration " +
+                (out_dir / "side.calibration.yaml").string() + " --port 2368 --format csv --out " + (dir / "side").string());
+  EXPECT_EQ(dec2_rc, 0) << dec2_out;
+  for (const char* sensor : {"top", "side"}) {
+    std::size_t files = 0;
+    if (std::filesystem::exists(dir / sensor))
+      for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir / sensor)) ++files;
+    EXPECT_GE(files, 3u) << sensor << ": one file per sweep";
+  }
   EXPECT_NE(runRigcal("sim --scenario nope --out " + dir.path().string()).first, 0);
 }
 

@@ -107,7 +107,7 @@ void run(const SimArgs& a) {
     for (const auto& m : missing) models += (models.empty() ? "" : ", ") + m;
     if (fs::exists(pcap)) fs::remove(pcap);  // never leave a capture that does not match this run
     std::cout << "recording.pcap NOT written: there is no packet encoder yet for " << models
-              << " (the vendor wire-format encoders are phase 2 of the simulator)\n";
+              << "\n";
   }
   std::unique_ptr<ScanDumper> dumper;
   if (a.dump_scans) dumper = std::make_unique<ScanDumper>(s, out / "scans");

@@ -1,0 +1,14 @@
+#pragma once
+// The vendor encoders behind makePacketEncoder, one file per vendor family. Each returns nullptr for
+// a model outside its family.
+#include <memory>
+
+#include "rigcal/sim/packet_encoder.hpp"
+
+namespace rigcal::sim::encoders {
+
+std::unique_ptr<PacketEncoder> makeVelodyneEncoder(const LidarModel& model, const EncoderConfig& config);
+std::unique_ptr<PacketEncoder> makeOusterEncoder(const LidarModel& model, const EncoderConfig& config);
+std::unique_ptr<PacketEncoder> makeHesaiEncoder(const LidarModel& model, const EncoderConfig& config);
+
+}  // namespace rigcal::sim::encoders
