@@ -5,8 +5,16 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <iterator>
 
+#include <yaml-cpp/yaml.h>
+
+#include "rigcal/core/pcd_io.hpp"
+#include "rigcal/core/ply_io.hpp"
+#include "rigcal/core/pose.hpp"
 #include "run_command.hpp"
+#include "sanitizers.hpp"
 #include "test_data.hpp"
 
 namespace rigcal::test {
@@ -95,6 +103,67 @@ TEST(CalibratePoseCli, PosesNotCoveringTheLidarTimeRangeNameBothRanges) {
             std::string::npos)
       << err;
   EXPECT_NE(err.find("lidar points span ["), std::string::npos) << err;
+}
+
+Pose poseOf(const YAML::Node& n) {
+  return fromXyzRpy({n["x"].as<double>(), n["y"].as<double>(), n["z"].as<double>(), n["roll"].as<double>(),
+                     n["pitch"].as<double>(), n["yaw"].as<double>()});
+}
+
+std::string readText(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The whole chain through the real binary: `rigcal sim` writes a VLP-16 capture in the wire format,
+// the pose sensor's CSV (noisy, UTM-sized coordinates) and the truth; `rigcal calibrate-pose` decodes the
+// capture as rig.yaml says and must recover truth.yaml's T_pose_lidar and time offset.
+TEST(CalibratePoseCli, RecoversTheSimulatedPoseScenarioFromItsPcap) {
+  TempDir sim, out;
+  std::vector<std::string> sim_args{"sim", "--scenario", "pose", "--out", sim.path().string()};
+  if (RIGCAL_SANITIZED) {  // instrumented binaries: 5 s of the drive, the exit codes and files only
+    std::string text = readText(RIGCAL_POSE_SCENARIO);
+    text = text.substr(0, text.find("  segments:")) +
+           "  segments:\n    - {type: accelerate, to_kmh: 6, duration: 2.0}\n"
+           "    - {type: turn, turn_deg: 60, duration: 3.0}\n";
+    std::ofstream(sim / "short.yaml") << text;
+    sim_args[2] = (sim / "short.yaml").string();
+  }
+  const auto simulated = runRigcal(sim_args);
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
+  ASSERT_TRUE(std::filesystem::exists(sim / "recording.pcap"));
+
+  std::vector<std::string> args{"calibrate-pose", "--pcap", (sim / "recording.pcap").string(), "--poses",
+                                (sim / "poses.csv").string(), "--config", (sim / "rig.yaml").string(),
+                                "--sensor", "lidar", "--out", out.path().string()};
+  if (RIGCAL_SANITIZED) args.insert(args.end(), {"--keep-ratio", "0.003", "--max-evals", "30"});
+  const auto r = runRigcal(args);
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  std::cout << r.out;
+  EXPECT_NE(r.out.find("Motion over"), std::string::npos) << "the observability report is printed";
+  EXPECT_NE(r.out.find("time offset to add to lidar timestamps"), std::string::npos);
+
+  const YAML::Node truth = YAML::LoadFile((sim / "truth.yaml").string())["pose_sensor"]["lidars"]["lidar"];
+  const Pose T_truth = poseOf(truth["T_pose_lidar"]);
+  const double offset_truth = truth["time_offset_to_add_to_lidar_s"].as<double>();
+  const YAML::Node got = YAML::LoadFile((out / "calibration.yaml").string())["pose_sensor"]["lidar"];
+  const Pose T_got = poseOf(got);
+  const double dt_cm = 100 * (T_got.translation() - T_truth.translation()).norm();
+  const double dr_deg = rad2deg(rotationAngleBetween(T_got, T_truth));
+  const double dtime_ms = 1e3 * std::abs(got["time_offset_s"].as<double>() - offset_truth);
+  std::cout << "calibrate-pose vs truth: " << dt_cm << " cm, " << dr_deg << " deg, " << dtime_ms << " ms\n";
+
+  const std::string text = readText(out / "calibration.txt");
+  EXPECT_NE(text.find("Active Transformation Matrix from the Pose Sensor Frame to  the Lidar Frame:"),
+            std::string::npos);
+  EXPECT_NE(text.find("Time offset that must be added to lidar timestamps in seconds:"), std::string::npos);
+  const PointTable cloud = readPly(out / "lidar_points.ply");
+  EXPECT_GT(cloud.size(), RIGCAL_SANITIZED ? 100u : 40000u);
+  for (const char* f : {"x", "y", "z", "intensity", "time"}) EXPECT_TRUE(cloud.has(f)) << f;
+  if (RIGCAL_SANITIZED) return;
+  EXPECT_LT(dt_cm, 2.0);
+  EXPECT_LT(dr_deg, 0.1);
+  EXPECT_LT(dtime_ms, 1.0);
 }
 
 }  // namespace
