@@ -39,10 +39,18 @@ struct CalibratePoseArgs {
   bool optimise_all = false;
 };
 
+// Joins the parts of a message (std::ostringstream: GCC 12 warns falsely on std::string operator+).
+template <typename... Parts>
+std::string cat(const Parts&... parts) {
+  std::ostringstream o;
+  (o << ... << parts);
+  return o.str();
+}
+
 void requireFile(const std::string& path, const char* what) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
-    throw CommandFailed(kExitInput, path + ": " + what + (fs::exists(path, ec) ? " is not a file" : " not found"));
+    throw CommandFailed(kExitInput, cat(path, ": ", what, fs::exists(path, ec) ? " is not a file" : " not found"));
 }
 
 struct Decoded {
@@ -120,7 +128,7 @@ std::string summary(const calib::LidarPoseResult& r) {
     << std::setprecision(6) << "time offset to add to lidar timestamps: " << r.time_offset_s << " s\n";
   std::string held;
   for (std::size_t i = 0; i < calib::kLidarPoseParams; ++i)
-    if (r.held[i]) held += std::string(held.empty() ? "" : ", ") + calib::lidarPoseParamName(calib::LidarPoseParam(i));
+    if (r.held[i]) held += cat(held.empty() ? "" : ", ", calib::lidarPoseParamName(calib::LidarPoseParam(i)));
   if (!held.empty()) o << "held at the initial guess (poorly constrained by the motion): " << held << '\n';
   return o.str();
 }
@@ -155,7 +163,7 @@ void run(CalibratePoseArgs a) {
   try {
     trajectory = std::make_unique<calib::PoseTrajectory>(csv);
   } catch (const std::exception& e) {
-    throw CommandFailed(kExitInput, a.poses + ": " + e.what());
+    throw CommandFailed(kExitInput, cat(a.poses, ": ", e.what()));
   }
   std::cout << "poses: " << csv.poses.size() << " from " << a.poses;
   if (!csv.origin.isZero())
@@ -169,13 +177,13 @@ void run(CalibratePoseArgs a) {
             << d.malformed << " malformed, " << d.lost << " lost); " << c.kept << " selected (keep ratio "
             << s.selection.keep_points_ratio << ")\n";
   if (!d.warning.empty()) std::cerr << "warning: " << d.warning << '\n';
-  if (c.scans == 0) throw CommandFailed(kExitNotEnoughData, a.pcap + ": no lidar scans decoded");
+  if (c.scans == 0) throw CommandFailed(kExitNotEnoughData, cat(a.pcap, ": no lidar scans decoded"));
 
   calib::LidarPoseResult r;
   try {
     r = calib::calibrateLidarPose(std::move(d.points), *trajectory, s);
   } catch (const std::exception& e) {  // poses not covering the lidar, too few points
-    throw CommandFailed(kExitInput, a.poses + " vs " + a.pcap + ": " + e.what());
+    throw CommandFailed(kExitInput, cat(a.poses, " vs ", a.pcap, ": ", e.what()));
   }
   std::cout << r.points.counts.outside_poses << " selected points dropped outside the poses' time range, "
             << r.points.size() << " used\n";
@@ -188,7 +196,7 @@ void run(CalibratePoseArgs a) {
     const fs::path out(a.out);
     std::error_code ec;
     fs::create_directories(out, ec);
-    if (ec) throw CommandFailed(kExitInput, out.string() + ": cannot create the output folder: " + ec.message());
+    if (ec) throw CommandFailed(kExitInput, cat(out.string(), ": cannot create the output folder: ", ec.message()));
     try {
       calib::writeLidarPoseCalibrationText(out / "calibration.txt", r, csv.origin);
       calib::writeLidarPoseYaml(out / "calibration.yaml", r, "pose_sensor", d.name);
