@@ -117,11 +117,11 @@ TEST_P(LidarPoseOnSimulatedPoseScenario, RecoversExtrinsicAndTimeOffsetWithin2cm
 INSTANTIATE_TEST_SUITE_P(Seeds, LidarPoseOnSimulatedPoseScenario, ::testing::Values(4u, 11u, 23u));
 
 TEST(LidarPoseOnSimulatedPoseScenario, RepeatedRunsAreBitIdentical) {
-  const SimRun run = simulatePose(4, kSanitized ? 3.0 : 10.0);
+  const SimRun run = simulatePose(4, kSanitized ? 3.0 : 6.0);
   const PoseTrajectory trajectory(run.poses);
   LidarPoseSettings settings = testSettings();
   const LidarPoseResult a = calibrateLidarPose(run.scans, trajectory, settings);
-  const SimRun again = simulatePose(4, kSanitized ? 3.0 : 10.0);
+  const SimRun again = simulatePose(4, kSanitized ? 3.0 : 6.0);
   const LidarPoseResult b = calibrateLidarPose(again.scans, PoseTrajectory(again.poses), settings);
   EXPECT_GT(a.local_evaluations, kSanitized ? 10u : 20u);
   EXPECT_TRUE(bitIdentical(a, b)) << "a second simulation + calibration differs";
