@@ -22,5 +22,6 @@ void addMonitorCommand(CLI::App& app);
 void addSimCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
+void addCalibratePoseCommand(CLI::App& app);
 
 }  // namespace rigcal::app

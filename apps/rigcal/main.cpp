@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   addSimCommand(app);
   addMapCommand(app);
   addCompareCommand(app);
+  addCalibratePoseCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -84,6 +84,14 @@ ObservabilityReport assessObservability(const PoseTrajectory& trajectory, TimeNs
            "translation along " + std::string(kAxis[a]) + " needs rotation about another axis: " +
                ranges(std::min(b, c), std::max(b, c)));
   }
+  const double tilt = std::max(rr[0], rr[1]);
+  if (!r.flagged(LidarPoseParam::kZ) && tilt < s.min_tilt_range_for_z_deg) {
+    std::ostringstream why;
+    why << "translation along z is seen only through tilt (an error dz moves points sideways by "
+           "dz*sin(tilt)): rotation about x "
+        << fmt(rr[0]) << "°, about y " << fmt(rr[1]) << "° < " << fmt(s.min_tilt_range_for_z_deg) << "°";
+    flag(LidarPoseParam::kZ, why.str());
+  }
   if (rr[0] < R && rr[1] < R) {
     const std::string why = "roll and pitch need non-planar motion: " + ranges(0, 1);
     flag(LidarPoseParam::kRoll, why);

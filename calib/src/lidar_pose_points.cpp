@@ -48,37 +48,39 @@ bool keepPoint(std::uint64_t seed, std::uint64_t sequence, std::size_t index, do
   return static_cast<double>(h >> 11) * 0x1.0p-53 < ratio;
 }
 
-LidarPoints selectLidarPoints(const std::vector<Scan>& scans, const LidarPointSelection& sel) {
-  LidarPoints out;
+void appendLidarPoints(const Scan& scan, const LidarPointSelection& sel, LidarPoints& out) {
   auto& c = out.counts;
-  c.scans = scans.size();
+  ++c.scans;
   const double min_sq = sel.min_point_distance * sel.min_point_distance;
   const double max_sq = sel.max_point_distance * sel.max_point_distance;
-  for (const Scan& scan : scans) {
-    c.input += scan.size();
-    for (std::size_t i = 0; i < scan.size(); ++i) {
-      if (!keepPoint(sel.seed, scan.sequence, i, sel.keep_points_ratio)) {
-        ++c.not_sampled;
-        continue;
-      }
-      if (!(scan.intensity[i] > sel.min_return_intensity)) {
-        ++c.low_intensity;
-        continue;
-      }
-      const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
-      const double sq = px * px + py * py + pz * pz;
-      if (!std::isfinite(sq) || !(sq > min_sq) || !(sq < max_sq)) {
-        ++c.out_of_range;
-        continue;
-      }
-      out.x.push_back(scan.x[i]);
-      out.y.push_back(scan.y[i]);
-      out.z.push_back(scan.z[i]);
-      out.intensity.push_back(scan.intensity[i]);
-      out.time_ns.push_back(scan.pointTime(i));
+  c.input += scan.size();
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    if (!keepPoint(sel.seed, scan.sequence, i, sel.keep_points_ratio)) {
+      ++c.not_sampled;
+      continue;
     }
+    if (!(scan.intensity[i] > sel.min_return_intensity)) {
+      ++c.low_intensity;
+      continue;
+    }
+    const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
+    const double sq = px * px + py * py + pz * pz;
+    if (!std::isfinite(sq) || !(sq > min_sq) || !(sq < max_sq)) {
+      ++c.out_of_range;
+      continue;
+    }
+    out.x.push_back(scan.x[i]);
+    out.y.push_back(scan.y[i]);
+    out.z.push_back(scan.z[i]);
+    out.intensity.push_back(scan.intensity[i]);
+    out.time_ns.push_back(scan.pointTime(i));
   }
   c.kept = out.size();
+}
+
+LidarPoints selectLidarPoints(const std::vector<Scan>& scans, const LidarPointSelection& sel) {
+  LidarPoints out;
+  for (const Scan& scan : scans) appendLidarPoints(scan, sel, out);
   return out;
 }
 

@@ -10,34 +10,18 @@
 namespace rigcal::calib {
 namespace {
 
-// a·exp(τ·ξ) with ξ = (rho, angle·axis): closed-form SE(3) exponential. With φ = τ·angle and K the
-// skew matrix of the axis: R = I + sin φ K + (1 − cos φ) K², t = (I + (1 − cos φ)/φ K + (1 − sin φ/φ) K²)·τρ.
-Pose geodesicStep(const Pose& a, const Eigen::Vector3d& rho, const Eigen::Vector3d& axis, double angle,
-                  double tau) {
-  const double phi = tau * angle;
-  double s, c1, j1, j2;  // sin φ, 1 − cos φ, and the two translation coefficients
+// The coefficients of the SE(3) exponential at φ: sin φ, 1 − cos φ, (1 − cos φ)/φ, 1 − sin φ/φ.
+struct ExpCoefficients {
+  double s, c1, j1, j2;
+};
+ExpCoefficients expCoefficients(double phi) {
   if (std::abs(phi) < 1e-4) {  // series: avoids 0/0, exact to double precision at this size
     const double p2 = phi * phi;
-    s = phi * (1.0 - p2 / 6.0);
-    c1 = 0.5 * p2 * (1.0 - p2 / 12.0);
-    j1 = 0.5 * phi * (1.0 - p2 / 12.0);
-    j2 = p2 / 6.0 * (1.0 - p2 / 20.0);
-  } else {
-    s = std::sin(phi);
-    c1 = 1.0 - std::cos(phi);
-    j1 = c1 / phi;
-    j2 = 1.0 - s / phi;
+    return {phi * (1.0 - p2 / 6.0), 0.5 * p2 * (1.0 - p2 / 12.0), 0.5 * phi * (1.0 - p2 / 12.0),
+            p2 / 6.0 * (1.0 - p2 / 20.0)};
   }
-  const Eigen::Matrix3d K = skew(axis);
-  const Eigen::Matrix3d K2 = K * K;
-  const Eigen::Matrix3d R = Eigen::Matrix3d::Identity() + s * K + c1 * K2;
-  const Eigen::Vector3d v = tau * rho;
-  const Eigen::Vector3d t = v + j1 * (K * v) + j2 * (K2 * v);
-  Pose out;
-  out.linear() = a.linear() * R;
-  out.translation() = a.linear() * t + a.translation();
-  out.makeAffine();
-  return out;
+  const double s = std::sin(phi), c1 = 1.0 - std::cos(phi);
+  return {s, c1, c1 / phi, 1.0 - s / phi};
 }
 
 }  // namespace
@@ -59,10 +43,17 @@ PoseTrajectory::PoseTrajectory(std::vector<TimeNs> stamps, std::vector<Pose> pos
     rel_ns_.push_back(static_cast<double>(stamps_[i] - stamps_[0]));
     if (i == 0) continue;
     const Vector6d xi = logSE3(poses_[i - 1].inverse() * poses_[i]);
+    const Eigen::Vector3d rho = xi.head<3>();
     Segment seg;
-    seg.rho = xi.head<3>();
     seg.angle = xi.tail<3>().norm();
-    seg.axis = seg.angle > 0.0 ? Eigen::Vector3d(xi.tail<3>() / seg.angle) : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d axis = seg.angle > 0.0 ? Eigen::Vector3d(xi.tail<3>() / seg.angle) : Eigen::Vector3d::UnitX();
+    const Eigen::Matrix3d K = skew(axis);
+    const Eigen::Matrix3d& aR = poses_[i - 1].linear();
+    seg.RK = aR * K;
+    seg.RK2 = seg.RK * K;
+    seg.u0 = aR * rho;
+    seg.u1 = seg.RK * rho;
+    seg.u2 = seg.RK2 * rho;
     segments_.push_back(seg);
   }
 }
@@ -89,7 +80,13 @@ std::optional<Pose> PoseTrajectory::at(TimeNs t, double offset_s, std::size_t* h
   if (!i) return std::nullopt;
   const double tau = (rel - rel_ns_[*i]) / (rel_ns_[*i + 1] - rel_ns_[*i]);
   const Segment& seg = segments_[*i];
-  return geodesicStep(poses_[*i], seg.rho, seg.axis, seg.angle, tau);
+  const ExpCoefficients k = expCoefficients(tau * seg.angle);
+  const Pose& a = poses_[*i];
+  Pose out;
+  out.linear() = a.linear() + k.s * seg.RK + k.c1 * seg.RK2;
+  out.translation() = a.translation() + tau * (seg.u0 + k.j1 * seg.u1 + k.j2 * seg.u2);
+  out.makeAffine();
+  return out;
 }
 
 }  // namespace rigcal::calib

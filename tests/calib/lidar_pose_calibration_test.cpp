@@ -135,6 +135,30 @@ TEST(LidarPoseCalibration, PlanarMotionFlagsRollPitchAndZAndHoldsThemAtTheInitia
   EXPECT_LT(e.time_ms, 1.0 * scale);
 }
 
+TEST(LidarPoseObservability, ZNeedsAWideTiltRangeNotJustSomeTilt) {
+  test::SyntheticOptions o;  // only the poses matter here
+  o.duration_s = 8.0;
+  o.columns = 20;
+  o.roll_amplitude_deg = 5.0;
+  o.pitch_amplitude_deg = 4.0;
+  const test::SyntheticRecording mild = test::makeSyntheticRecording(o);
+  const PoseTrajectory mild_traj(mild.pose_stamps, mild.poses);
+  const ObservabilityReport m = assessObservability(mild_traj, mild_traj.begin(), mild_traj.end());
+  std::cout << m.text();
+  EXPECT_TRUE(m.flagged(LidarPoseParam::kZ));
+  EXPECT_NE(m.reason[static_cast<std::size_t>(LidarPoseParam::kZ)].find("seen only through tilt"),
+            std::string::npos);
+  for (const LidarPoseParam p : {LidarPoseParam::kX, LidarPoseParam::kY, LidarPoseParam::kRoll,
+                                 LidarPoseParam::kPitch, LidarPoseParam::kYaw, LidarPoseParam::kTimeOffset})
+    EXPECT_FALSE(m.flagged(p)) << lidarPoseParamName(p);
+
+  o.roll_amplitude_deg = 15.0;
+  o.pitch_amplitude_deg = 12.0;
+  const test::SyntheticRecording shaken = test::makeSyntheticRecording(o);
+  const PoseTrajectory shaken_traj(shaken.pose_stamps, shaken.poses);
+  EXPECT_FALSE(assessObservability(shaken_traj, shaken_traj.begin(), shaken_traj.end()).flagged(LidarPoseParam::kZ));
+}
+
 TEST(LidarPoseCalibration, AStationaryRecordingHoldsEveryParameterAtTheGuess) {
   test::SyntheticOptions o;
   o.duration_s = 1.0;

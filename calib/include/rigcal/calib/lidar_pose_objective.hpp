@@ -9,7 +9,8 @@
 // r = sqrt(max_dist_sq) change the sum, so the cloud is radix-sorted by (z cell, y cell, fine x) with
 // cells of size r. Each (y, z) column is then one run ordered by x; a query visits its own and the 8
 // neighbouring columns (found by cursors that only move forward), skips a column whose y/z gap already
-// exceeds the best distance, and scans outwards in x until |Δx| alone does. All buffers are allocated
+// exceeds the best distance, and scans outwards in x until |Δx| alone does. Each query starts from the
+// distance to its previous nearest neighbour (warm start). All buffers are allocated
 // once; poses are re-interpolated only when the time offset changes; the work is split over 1..n
 // threads and reduced in a fixed order, so the result is bit-identical for any thread count and run.
 #include <cstddef>
@@ -71,7 +72,7 @@ class LidarPoseObjective {
   std::vector<float> part_min_, part_max_;  // per part: bounding box (x, y, z)
   float max_sq_ = 1.0f;
   float inv_cell_ = 1.0f, cell_ = 1.0f;        // y, z cells: a fraction of the neighbour radius
-  float inv_quantum_ = 1.0f, quantum_ = 1.0f;  // x quantum: a 32nd of the radius
+  float inv_quantum_ = 1.0f, quantum_ = 1.0f;  // x quantum: a 256th of the radius
   std::int64_t origin_[3] = {0, 0, 0};  // lowest x quantum / y, z cell, minus a margin
   std::uint64_t nx_ = 0, nxy_ = 0;      // x quanta per column, quanta per z layer
 
@@ -87,6 +88,12 @@ class LidarPoseObjective {
   std::vector<SortedPoint> sorted_;
   std::vector<std::size_t> sweep_split_;  // part p sweeps sorted positions [split[p], split[p+1])
   std::vector<float> cost_;               // per sorted position
+  // Per point (input order): its nearest neighbour at the previous evaluation, or kNoPartner. The
+  // optimiser moves the cloud little between evaluations, so the distance to that point, measured at
+  // the new positions, starts the search with a tight bound and prunes most candidates. It is a real
+  // distance to another point, so the minimum found — and the sum — are exactly what a cold search gives.
+  static constexpr std::uint32_t kNoPartner = 0xffffffffu;
+  std::vector<std::uint32_t> partner_;
 };
 
 }  // namespace rigcal::calib

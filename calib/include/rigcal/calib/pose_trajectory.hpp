@@ -36,9 +36,15 @@ class PoseTrajectory {
   [[nodiscard]] std::optional<Pose> at(TimeNs t, double offset_s, std::size_t* hint = nullptr) const;
 
  private:
-  // Segment i joins pose i and i+1: its tangent log(a⁻¹·b) = (rho, omega), precomputed once.
+  // Segment i joins pose a = pose i and b = pose i+1 along a·exp(τ·ξ), ξ = log(a⁻¹·b) = (rho, angle·axis).
+  // With K the skew matrix of the axis, φ = τ·angle and the closed-form SE(3) exponential,
+  //   R(τ) = a.R + sin φ·(a.R·K) + (1 − cos φ)·(a.R·K²)
+  //   t(τ) = a.t + τ·(a.R·rho + j1(φ)·a.R·K·rho + j2(φ)·a.R·K²·rho),
+  // so the products with a.R are precomputed once per segment and a query costs 27 multiply-adds
+  // (plus sin/cos when φ is not tiny) instead of three 3×3 matrix products.
   struct Segment {
-    Eigen::Vector3d rho, axis;  // axis: unit rotation axis (any unit vector when angle = 0)
+    Eigen::Matrix3d RK, RK2;   // a.R·K, a.R·K²
+    Eigen::Vector3d u0, u1, u2;  // a.R·rho, a.R·K·rho, a.R·K²·rho
     double angle = 0.0;
   };
   [[nodiscard]] std::optional<std::size_t> locate(double rel_ns, std::size_t* hint) const;

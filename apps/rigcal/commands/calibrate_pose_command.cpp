@@ -1,0 +1,267 @@
+// `rigcal calibrate-pose --pcap F --poses CSV (--config rig.yaml --sensor NAME | --model M ...) [--out DIR]`:
+// lidar-to-pose-sensor calibration with time offset (the lidar_align successor). Decodes one lidar's
+// packets (every point keeps its own time), selects lidar_align's subset of the returns as the scans
+// arrive, calibrates against the poses and writes lidar_align's text, calibration.yaml and the fused
+// cloud as PLY.
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "../commands.hpp"
+#include "../exit_codes.hpp"
+#include "rigcal/calib/lidar_pose_calibration.hpp"
+#include "rigcal/calib/lidar_pose_output.hpp"
+#include "rigcal/calib/pose_csv.hpp"
+#include "rigcal/config/config_error.hpp"
+#include "rigcal/config/rig_config.hpp"
+#include "rigcal/drivers/packet_decoder.hpp"
+#include "rigcal/drivers/pcap_source.hpp"
+#include "rigcal/drivers/scan_assembler.hpp"
+#include "rigcal/drivers/scan_pump.hpp"
+#include "rigcal/pipeline/sensor_driver.hpp"
+
+namespace rigcal::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CalibratePoseArgs {
+  std::string pcap, poses, config, sensor, model, calibration, metadata, address, out;
+  std::string time_source = "sensor";
+  int port = 0;
+  std::uint64_t seed = 0;
+  std::vector<double> initial;  // x y z (m) roll pitch yaw (deg)
+  double initial_time_offset_s = 0.0;
+  calib::LidarPoseSettings settings;
+  bool optimise_all = false;
+};
+
+// Joins the parts of a message (std::ostringstream: GCC 12 warns falsely on std::string operator+).
+template <typename... Parts>
+std::string cat(const Parts&... parts) {
+  std::ostringstream o;
+  (o << ... << parts);
+  return o.str();
+}
+
+void requireFile(const std::string& path, const char* what) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw CommandFailed(kExitInput, cat(path, ": ", what, fs::exists(path, ec) ? " is not a file" : " not found"));
+}
+
+struct Decoded {
+  calib::LidarPoints points;
+  std::string name;  // the lidar's frame name in calibration.yaml
+  std::size_t packets = 0, malformed = 0, lost = 0;
+  std::string warning;
+};
+
+// Decodes the capture, selecting each scan's returns as it arrives (nothing else is kept).
+Decoded decode(const CalibratePoseArgs& a, const calib::LidarPointSelection& selection) {
+  Decoded d;
+  const auto on_scan = [&](Scan&& scan) { calib::appendLidarPoints(scan, selection, d.points); };
+  if (!a.config.empty()) {
+    config::RigConfig rig;
+    try {
+      rig = config::loadRigConfig(a.config);
+    } catch (const config::ConfigError& e) {
+      throw CommandFailed(fs::exists(a.config) ? kExitConfig : kExitInput, e.what());
+    }
+    const config::SensorConfig* sensor = nullptr;
+    try {
+      sensor = &rig.sensor(a.sensor);
+    } catch (const config::ConfigError& e) {
+      throw CommandFailed(kExitConfig, e.what());
+    }
+    d.name = sensor->name;
+    const std::atomic<bool> stop{false};
+    std::unique_ptr<pipeline::SensorDriver> driver;
+    try {
+      driver = std::make_unique<pipeline::SensorDriver>(*sensor, pipeline::DriverInput{fs::path(a.pcap), 0.0}, stop,
+                                                        on_scan);
+    } catch (const std::exception& e) {
+      throw CommandFailed(kExitInput, e.what());
+    }
+    driver->run();
+    d.packets = driver->assemblerStats().packets;
+    d.malformed = driver->assemblerStats().malformed;
+    d.lost = driver->assemblerStats().lost_packets;
+    d.warning = driver->warning();
+    return d;
+  }
+  drivers::DecoderConfig config;
+  config.model = a.model;
+  config.calibration = a.calibration;
+  config.metadata = a.metadata;
+  config.time_source = a.time_source == "host" ? TimeSource::kHostReceive : TimeSource::kSensorClock;
+  std::unique_ptr<drivers::PacketDecoder> decoder;
+  std::unique_ptr<drivers::PcapSource> source;
+  try {
+    decoder = drivers::makeDecoder(config);
+    drivers::PacketFilter filter;
+    if (a.port) filter.destination_port = std::uint16_t(a.port);
+    if (!a.address.empty()) filter.source_address = drivers::parseIpv4(a.address);
+    source = std::make_unique<drivers::PcapSource>(a.pcap, filter);
+  } catch (const std::exception& e) {
+    throw CommandFailed(kExitInput, e.what());
+  }
+  d.name = "lidar";
+  drivers::ScanAssembler assembler(a.model, drivers::AssemblerConfig{}, on_scan);
+  drivers::pumpScans(*source, *decoder, assembler);
+  d.packets = assembler.stats().packets;
+  d.malformed = assembler.stats().malformed;
+  d.lost = assembler.stats().lost_packets;
+  d.warning = source->warning();
+  return d;
+}
+
+std::string summary(const calib::LidarPoseResult& r) {
+  const XyzRpy v = toXyzRpy(r.T_pose_lidar);
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(4) << "T_pose_lidar: x " << v.x << " m, y " << v.y << " m, z " << v.z
+    << " m, roll " << rad2deg(v.roll) << " deg, pitch " << rad2deg(v.pitch) << " deg, yaw " << rad2deg(v.yaw)
+    << " deg\n"
+    << std::setprecision(6) << "time offset to add to lidar timestamps: " << r.time_offset_s << " s\n";
+  std::string held;
+  for (std::size_t i = 0; i < calib::kLidarPoseParams; ++i)
+    if (r.held[i]) held += cat(held.empty() ? "" : ", ", calib::lidarPoseParamName(calib::LidarPoseParam(i)));
+  if (!held.empty()) o << "held at the initial guess (poorly constrained by the motion): " << held << '\n';
+  return o.str();
+}
+
+void run(CalibratePoseArgs a) {
+  if (a.config.empty() == a.model.empty())
+    throw CommandFailed(kExitUsage, "calibrate-pose: give either --config with --sensor, or --model");
+  if (!a.config.empty() && a.sensor.empty())
+    throw CommandFailed(kExitUsage, "calibrate-pose: --config needs --sensor NAME");
+  requireFile(a.pcap, "capture");
+  requireFile(a.poses, "pose file");
+  if (!a.config.empty()) requireFile(a.config, "rig file");
+
+  calib::LidarPoseSettings& s = a.settings;
+  s.selection.seed = a.seed;
+  s.hold_poorly_constrained = !a.optimise_all;
+  s.initial_time_offset_s = a.initial_time_offset_s;
+  if (!a.initial.empty()) {
+    if (a.initial.size() != 6)
+      throw CommandFailed(kExitUsage, "calibrate-pose: --initial needs 6 values: x y z (m) roll pitch yaw (deg)");
+    s.initial_T_pose_lidar = fromXyzRpy({a.initial[0], a.initial[1], a.initial[2], deg2rad(a.initial[3]),
+                                         deg2rad(a.initial[4]), deg2rad(a.initial[5])});
+  }
+
+  calib::PoseCsv csv;
+  try {
+    csv = calib::readPoseCsv(a.poses);
+  } catch (const std::exception& e) {
+    throw CommandFailed(kExitInput, e.what());
+  }
+  std::unique_ptr<calib::PoseTrajectory> trajectory;
+  try {
+    trajectory = std::make_unique<calib::PoseTrajectory>(csv);
+  } catch (const std::exception& e) {
+    throw CommandFailed(kExitInput, cat(a.poses, ": ", e.what()));
+  }
+  std::cout << "poses: " << csv.poses.size() << " from " << a.poses;
+  if (!csv.origin.isZero())
+    std::cout << std::fixed << std::setprecision(3) << " (re-centred by [" << csv.origin.x() << ", "
+              << csv.origin.y() << ", " << csv.origin.z() << "])";
+  std::cout << '\n';
+
+  Decoded d = decode(a, s.selection);
+  const auto& c = d.points.counts;
+  std::cout << "lidar: " << c.scans << " scans, " << c.input << " returns from " << d.packets << " packets ("
+            << d.malformed << " malformed, " << d.lost << " lost); " << c.kept << " selected (keep ratio "
+            << s.selection.keep_points_ratio << ")\n";
+  if (!d.warning.empty()) std::cerr << "warning: " << d.warning << '\n';
+  if (c.scans == 0) throw CommandFailed(kExitNotEnoughData, cat(a.pcap, ": no lidar scans decoded"));
+
+  calib::LidarPoseResult r;
+  try {
+    r = calib::calibrateLidarPose(std::move(d.points), *trajectory, s);
+  } catch (const std::exception& e) {  // poses not covering the lidar, too few points
+    throw CommandFailed(kExitInput, cat(a.poses, " vs ", a.pcap, ": ", e.what()));
+  }
+  std::cout << r.points.counts.outside_poses << " selected points dropped outside the poses' time range, "
+            << r.points.size() << " used\n";
+  std::cout << summary(r) << r.observability.text();
+  std::cout << std::setprecision(6) << "cost: initial " << r.initial_cost << ", final " << r.final_cost
+            << "; evaluations " << r.global_evaluations << " global + " << r.local_evaluations << " local; "
+            << std::setprecision(3) << r.total_seconds << " s\n";
+
+  if (!a.out.empty()) {
+    const fs::path out(a.out);
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec) throw CommandFailed(kExitInput, cat(out.string(), ": cannot create the output folder: ", ec.message()));
+    try {
+      calib::writeLidarPoseCalibrationText(out / "calibration.txt", r, csv.origin);
+      calib::writeLidarPoseYaml(out / "calibration.yaml", r, "pose_sensor", d.name);
+      calib::writeLidarPoseCloud(out / "lidar_points.ply", r.points, *trajectory, r.T_pose_lidar,
+                                 r.time_offset_s);
+    } catch (const std::exception& e) {
+      throw CommandFailed(kExitFailure, e.what());
+    }
+    std::cout << "wrote " << (out / "calibration.txt").string() << ", calibration.yaml, lidar_points.ply\n";
+  }
+  if (!(r.final_cost <= r.initial_cost))
+    throw CommandFailed(kExitFailure, "calibrate-pose: the result does not improve on the initial guess");
+}
+
+}  // namespace
+
+void addCalibratePoseCommand(CLI::App& app) {
+  auto a = std::make_shared<CalibratePoseArgs>();
+  auto* cmd = app.add_subcommand(
+      "calibrate-pose", "Calibrate a lidar against a 6-DOF pose sensor (extrinsic + time offset), lidar_align style");
+  cmd->add_option("--pcap", a->pcap, "pcap or pcapng capture of the lidar")->required();
+  cmd->add_option("--poses", a->poses, "Poses CSV: timestamp_ns, index, px, py, pz, qw, qx, qy, qz")->required();
+  cmd->add_option("--config", a->config, "Rig file: decode the lidar as configured there (with --sensor)");
+  cmd->add_option("--sensor", a->sensor, "The rig file's name of the lidar");
+  cmd->add_option("--model", a->model, "Lidar model when no rig file is given, e.g. VLP-16, OS1-64");
+  cmd->add_option("--calibration", a->calibration, "With --model: Velodyne YAML/XML or Hesai angle CSV");
+  cmd->add_option("--metadata", a->metadata, "With --model: Ouster sensor_info JSON");
+  cmd->add_option("--port", a->port, "With --model: only datagrams to this UDP port")->check(CLI::Range(1, 65535));
+  cmd->add_option("--address", a->address, "With --model: only datagrams from this IPv4 address");
+  cmd->add_option("--time-source", a->time_source, "With --model: sensor (packet clock) or host")
+      ->check(CLI::IsMember({"sensor", "host"}));
+  cmd->add_option("--out", a->out, "Write calibration.txt, calibration.yaml and lidar_points.ply here");
+  cmd->add_option("--seed", a->seed, "Salt of the deterministic point subset");
+  auto& s = a->settings;
+  cmd->add_option("--keep-ratio", s.selection.keep_points_ratio, "Fraction of the returns used")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--min-range", s.selection.min_point_distance, "Drop returns closer than this (m)")
+      ->capture_default_str();
+  cmd->add_option("--max-range", s.selection.max_point_distance, "Drop returns farther than this (m)")
+      ->capture_default_str();
+  cmd->add_option("--min-intensity", s.selection.min_return_intensity, "Keep returns brighter than this")
+      ->capture_default_str();
+  cmd->add_option("--initial", a->initial, "Initial T_pose_lidar: x y z (m) roll pitch yaw (deg)")->expected(6);
+  cmd->add_option("--initial-time-offset", a->initial_time_offset_s, "Initial time offset (s)");
+  cmd->add_flag("--local", s.local, "Skip the global rotation search (start from --initial)");
+  cmd->add_option("--max-time-offset", s.max_time_offset, "Time offset search range ± (s)")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  cmd->add_option("--translation-range", s.translation_range, "Translation search range ± (m)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  cmd->add_option("--angular-range", s.angular_range, "Local rotation search range ± (rad)")
+      ->check(CLI::Range(0.0, 3.2))
+      ->capture_default_str();
+  cmd->add_option("--max-evals", s.max_evals, "Evaluations per optimisation stage")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_flag("--no-time-offset", [a](std::int64_t) { a->settings.time_cal = false; },
+                "Keep the time offset at its initial value");
+  cmd->add_flag("--optimise-all", a->optimise_all,
+                "Also optimise parameters the motion leaves poorly constrained (lidar_align's behaviour)");
+  cmd->add_option("--threads", s.threads, "Worker threads")->check(CLI::Range(1, 64))->capture_default_str();
+  cmd->footer(kExitCodesHelp);
+  cmd->callback([a] { run(*a); });
+}
+
+}  // namespace rigcal::app
