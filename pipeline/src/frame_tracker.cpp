@@ -115,17 +115,21 @@ std::optional<std::string> FrameTracker::keyframeLostReason(const MappingFrame& 
     const MappingFrame& kf_prev = frames_[keyframes_[keyframes_.size() - 2]];
     const Eigen::Vector3d d1 = kf.T_map_lidar.translation() - kf_prev.T_map_lidar.translation();
     const Eigen::Vector3d d2 = candidate.T_map_lidar.translation() - kf.T_map_lidar.translation();
-    if (d1.norm() > 1e-6 && d2.norm() > 1e-6) {
+    // Only over real travel: between stopped keyframes the "direction" is registration noise.
+    const double min_travel = 0.5 * params_.new_keyframe_min_distance;
+    if (d1.norm() > min_travel && d2.norm() > min_travel) {
       const double angle = rad2deg(std::acos(std::clamp(d1.normalized().dot(d2.normalized()), -1.0, 1.0)));
       if (angle > params_.lost_frame_max_angle_diff)
         return "direction changed " + std::to_string(angle) + "° between keyframes";
     }
   }
-  // Frames between the two keyframes must lie on their interpolation.
-  for (std::size_t i = keyframes_.back() + 1; i < frames_.size(); ++i) {
+  // Frames between the two keyframes must lie on their interpolation. Interpolated by path length, not
+  // time: by time, every start from a stop (the speed changes between the keyframes) would be "lost".
+  const double span = candidate.path_length - kf.path_length;
+  for (std::size_t i = keyframes_.back() + 1; i < frames_.size() && span > 0; ++i) {
     const MappingFrame& mid = frames_[i];
-    const Pose expected = interpolateAt(kf.stamp_ns, kf.T_map_lidar, candidate.stamp_ns,
-                                        candidate.T_map_lidar, mid.stamp_ns);
+    const Pose expected = interpolateLerpSlerp(kf.T_map_lidar, candidate.T_map_lidar,
+                                               (mid.path_length - kf.path_length) / span);
     const double error = (expected.translation() - mid.T_map_lidar.translation()).norm();
     if (error > params_.lost_frame_interpolation_error)
       return "frame " + std::to_string(mid.sequence) + " is " + std::to_string(error) +

@@ -120,6 +120,17 @@ TEST(FrameTracker, KeyframeLostCheckFiresOnAFrameOffTheInterpolation) {
   EXPECT_TRUE(lost);
 }
 
+TEST(FrameTracker, AcceleratingFromAStopIsNotLost) {
+  // x = a·t²/2 from rest: by time, the frames between two keyframes lag far behind a linear interpolation.
+  Drive d;
+  for (int i = 0; i < 8; ++i) d.step(at(0.0));
+  for (int i = 1; i <= 60; ++i) {
+    const double t = 0.1 * i;
+    const MappingFrame f = d.step(at(0.3 * t * t));
+    EXPECT_FALSE(f.lost) << "frame at " << t << " s: " << f.lost_reason;
+  }
+}
+
 TEST(FrameTracker, SmoothTurnIsNotLost) {
   Drive d;
   const double radius = 8.0, v = 5.0 / 3.6;

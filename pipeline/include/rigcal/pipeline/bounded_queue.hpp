@@ -57,6 +57,17 @@ class BoundedQueue {
     return item;
   }
 
+  /// Never waits: the next item, or nullopt when the queue is empty.
+  std::optional<T> tryPop() {
+    if (!items_.tryWait()) return std::nullopt;
+    T item;
+    while (!queue_.try_dequeue(item)) {
+    }
+    depth_.fetch_sub(1, std::memory_order_relaxed);
+    slots_.signal();
+    return item;
+  }
+
   /// Wakes blocked producers; consumers drain what is left, then see empty pops.
   void close() { closed_.store(true, std::memory_order_release); }
   [[nodiscard]] bool closed() const { return closed_.load(std::memory_order_acquire); }

@@ -1,0 +1,67 @@
+#pragma once
+// The mapping lidar's mapper: deskews each scan with constant velocity from the last poses, registers it
+// against the local map (our GICP or NDT, per mapping_registrator), re-deskews it with the registered
+// motion, and classifies the frame by the upstream rules (FrameTracker). A registration that fails its
+// convergence or fitness check makes the frame lost (pose = the prediction) and the map is not fed from
+// it. The local map holds the last local_map_num_keyframes keyframes, restarting at a lost keyframe.
+// Single-threaded: the mapper stage owns it.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rigcal/config/parameters.hpp"
+#include "rigcal/core/scan.hpp"
+#include "rigcal/pipeline/frame_tracker.hpp"
+
+namespace rigcal::pipeline {
+
+/// What one registration reported (kept small: it goes into every frame event).
+struct RegistrationSummary {
+  std::string status;  // registration::toString(Status), or "first" for the map's first frame
+  int iterations = 0;
+  double inlier_ratio = 0.0;
+  double rmse = 0.0;
+  bool ok = false;  // passed the convergence and fitness checks
+};
+
+struct MapperOutput {
+  bool registered = false;     // false: the scan was skipped (see skipped_reason)
+  std::string skipped_reason;  // too few points, mapper full
+  MappingFrame frame;
+  RegistrationSummary registration;
+  /// Stored frames only: the deskewed cloud in the lidar frame at frame.stamp_ns, voxelised at
+  /// leaf_size_dense_map (positions; intensity is the voxel's mean, other fields zero).
+  std::shared_ptr<const Scan> cloud;
+};
+
+class Mapper {
+ public:
+  /// Fitness check: at least this fraction of the source within mapper_max_correspondence_distance
+  /// (GICP) or 1 m (NDT) of the local map.
+  static constexpr double kMinInlierRatio = 0.3;
+
+  explicit Mapper(const config::Parameters& params);
+  ~Mapper();
+  Mapper(const Mapper&) = delete;
+  Mapper& operator=(const Mapper&) = delete;
+
+  MapperOutput process(const Scan& scan);
+
+  [[nodiscard]] const FrameTracker& tracker() const;
+  /// mapping_max_frames frames are stored: further scans are skipped.
+  [[nodiscard]] bool done() const;
+  /// Points of the current local map target.
+  [[nodiscard]] std::size_t localMapPoints() const;
+  /// Every keyframe's cloud (voxel leaf_size_local_map) in the map frame, merged at leaf_size_local_map.
+  [[nodiscard]] std::shared_ptr<const Scan> mapCloud() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Keeps points with range in [min_range, max_range) and finite coordinates.
+void cropRange(Scan& scan, double min_range, double max_range);
+
+}  // namespace rigcal::pipeline

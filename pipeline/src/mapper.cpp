@@ -1,0 +1,253 @@
+#include "rigcal/pipeline/mapper.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <stdexcept>
+
+#include "rigcal/pipeline/deskew.hpp"
+#include "rigcal/registration/covariance.hpp"
+#include "rigcal/registration/gicp.hpp"
+#include "rigcal/registration/ndt.hpp"
+#include "rigcal/registration/target.hpp"
+#include "rigcal/registration/voxel_grid.hpp"
+
+namespace rigcal::pipeline {
+
+namespace reg = registration;
+
+void cropRange(Scan& scan, double min_range, double max_range) {
+  const double min2 = min_range * min_range, max2 = max_range * max_range;
+  scan.filter([&](std::size_t i) {
+    const double r2 = double(scan.x[i]) * scan.x[i] + double(scan.y[i]) * scan.y[i] + double(scan.z[i]) * scan.z[i];
+    return std::isfinite(r2) && r2 >= min2 && r2 < max2;
+  });
+}
+
+namespace {
+
+Scan toScan(const reg::PointCloud& cloud, const Scan& like) {
+  Scan s;
+  s.sensor_id = like.sensor_id;
+  s.sequence = like.sequence;
+  s.stamp_ns = like.stamp_ns;
+  s.reserve(cloud.size());
+  for (const auto& p : cloud.points) {
+    s.x.push_back(float(p.x()));
+    s.y.push_back(float(p.y()));
+    s.z.push_back(float(p.z()));
+  }
+  s.intensity.assign(s.size(), 0.0f);
+  s.ring.assign(s.size(), 0);
+  s.offset_ns.assign(s.size(), 0);
+  s.return_index.assign(s.size(), 0);
+  return s;
+}
+
+struct Keyframe {
+  reg::PointCloud cloud_in_map;  // voxelised at leaf_size_local_map
+};
+
+}  // namespace
+
+struct Mapper::Impl {
+  config::Parameters params;
+  FrameTracker tracker;
+  bool use_ndt = false;
+  std::deque<Keyframe> local;          // the local map's keyframes, oldest first
+  std::vector<reg::PointCloud> all_keyframes;  // every keyframe's cloud in the map frame (for the map)
+  std::shared_ptr<const reg::Target> target;
+  // The last two good registrations (mid-sweep poses and times): the motion model.
+  bool have_last = false, have_prev = false, last_failed = false;
+  FrameKind last_kind = FrameKind::kKeyframe;
+  int failures_in_a_row = 0;
+  static constexpr int kRestartAfterFailures = 2;
+
+  static TimeNs midSweep(const Scan& scan) {
+    std::uint32_t sweep = 0;
+    for (std::uint32_t o : scan.offset_ns) sweep = std::max(sweep, o);
+    return scan.stamp_ns + TimeNs(sweep / 2);
+  }
+  TimeNs last_stamp = 0, prev_stamp = 0;
+  Pose last_pose = Pose::Identity(), prev_pose = Pose::Identity();
+
+  explicit Impl(const config::Parameters& p) : params(p), tracker(p) {
+    if (p.mapping_registrator == "ndt") use_ndt = true;
+    else if (p.mapping_registrator != "gicp")
+      throw std::invalid_argument("mapping_registrator must be gicp or ndt, got '" + p.mapping_registrator + "'");
+  }
+
+  void rebuildTarget() {
+    reg::PointCloud merged;
+    for (const auto& k : local) merged.points.insert(merged.points.end(), k.cloud_in_map.points.begin(),
+                                                     k.cloud_in_map.points.end());
+    merged = reg::voxelDownsample(merged, params.leaf_size_local_map);
+    reg::TargetOptions o;
+    o.num_threads = std::max(1, params.mapper_num_threads);
+    if (use_ndt) o.ndt_resolutions = {params.mapper_resolution};
+    else o.normals_and_covariances = true;
+    target = std::make_shared<const reg::Target>(std::move(merged), o);
+  }
+
+  void addKeyframe(const Scan& deskewed, const Pose& T_map_lidar, bool restart) {
+    reg::PointCloud c = reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_local_map);
+    Keyframe k{reg::transformed(c, T_map_lidar)};
+    k.cloud_in_map.clearAttributes();
+    if (restart) local.clear();
+    all_keyframes.push_back(k.cloud_in_map);
+    local.push_back(std::move(k));
+    while (int(local.size()) > std::max(1, params.local_map_num_keyframes)) local.pop_front();
+    rebuildTarget();
+  }
+
+  static constexpr double kCoarseCorrespondence = 1.0;  // m
+
+  static bool accepted(const reg::RegistrationResult& r) {
+    return (r.status == reg::Status::kConverged || r.status == reg::Status::kMaxIterations) &&
+           r.inlier_ratio >= kMinInlierRatio;
+  }
+
+  static bool allFinite(const Pose& T) { return T.matrix().allFinite(); }
+
+  reg::RegistrationResult align(const reg::PointCloud& source, const Pose& guess, double max_corr) {
+    const int threads = std::max(1, params.mapper_num_threads);
+    if (use_ndt) {
+      reg::NdtParams np;
+      np.resolution = params.mapper_resolution;
+      np.step_size = params.mapper_step_size;
+      np.max_iterations = params.mapper_max_iterations;
+      np.num_threads = threads;
+      np.max_correspondence_distance = std::max(max_corr, 1.0);
+      return reg::alignNdt(*target, source, guess, np);
+    }
+    reg::GicpParams gp;
+    gp.max_correspondence_distance = max_corr;
+    gp.max_iterations = params.mapper_max_iterations;
+    gp.num_threads = threads;
+    return reg::alignGicp(*target, source, guess, gp);
+  }
+
+  Pose extrapolate(TimeNs stamp) const {
+    if (!have_prev || last_stamp <= prev_stamp) return last_pose;
+    const double steps = double(stamp - last_stamp) / double(last_stamp - prev_stamp);
+    return last_pose * expSE3(steps * logSE3(prev_pose.inverse() * last_pose));
+  }
+
+  SensorMotion motion(TimeNs stamp) const {
+    if (!have_prev || last_stamp <= prev_stamp) return [](TimeNs) { return Pose::Identity(); };
+    return constantVelocity(prev_pose.inverse() * last_pose, last_stamp - prev_stamp, stamp);
+  }
+
+  MapperOutput process(const Scan& input) {
+    MapperOutput out;
+    if (tracker.full()) {
+      out.skipped_reason = "mapper full (mapping_max_frames)";
+      return out;
+    }
+    Scan scan = input;
+    cropRange(scan, params.mapping_min_range, params.mapping_max_range);
+    if (int(scan.size()) < params.min_mapping_pointcloud_size) {
+      out.skipped_reason = std::to_string(scan.size()) + " points < min_mapping_pointcloud_size " +
+                           std::to_string(params.min_mapping_pointcloud_size);
+      return out;
+    }
+    out.registered = true;
+
+    Pose pose = Pose::Identity();
+    Scan deskewed = scan;
+    if (!target) {  // the first frame defines the map
+      out.registration = {"first", 0, 1.0, 0.0, true};
+    } else {
+      // Deskew to the middle of the sweep and register there. The motion model follows these mid-sweep
+      // poses only (pure registration results): were it fed the poses at the first point, which are
+      // extrapolated with the model's own velocity, a velocity error would come back amplified (the loop
+      // oscillates and grows while standing still).
+      const TimeNs mid = midSweep(scan);
+      const SensorMotion T_mid_sensor = motion(mid);
+      // Upstream: constant velocity, or the last pose after a stopped or lost frame. After a failed
+      // registration the motion of the last two good ones is still the best guess.
+      const bool hold = (last_kind == FrameKind::kStopped || last_kind == FrameKind::kStoppedKeyframe) && !last_failed;
+      const Pose guess = hold ? last_pose : extrapolate(mid);
+      deskew(deskewed, T_mid_sensor);
+      reg::PointCloud source = reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_input);
+      if (!use_ndt) {  // once, shared by the retries
+        reg::CovarianceOptions co;
+        co.num_threads = std::max(1, params.mapper_num_threads);
+        reg::estimateCovariances(source, co);
+      }
+      reg::RegistrationResult r = align(source, guess, params.mapper_max_correspondence_distance);
+      if (!accepted(r)) {
+        // Coarse then fine from the same guess: a jerk or a longer gap moves the scan beyond the fine
+        // correspondence distance; the frame's lost/kept status is still the tracker's call.
+        const reg::RegistrationResult coarse = align(source, guess, kCoarseCorrespondence);
+        if (accepted(coarse)) r = align(source, coarse.T_target_source, params.mapper_max_correspondence_distance);
+      }
+      const bool converged = r.status == reg::Status::kConverged || r.status == reg::Status::kMaxIterations;
+      const bool fit = r.inlier_ratio >= kMinInlierRatio && allFinite(r.T_target_source);
+      out.registration = {std::string(reg::toString(r.status)), r.iterations, r.inlier_ratio, r.rmse,
+                          converged && fit};
+      if (converged && !fit) out.registration.status += ", inlier ratio below " + std::to_string(kMinInlierRatio);
+      const Pose mid_pose = out.registration.ok ? r.T_target_source : guess;
+      if (out.registration.ok && have_last && mid > last_stamp) {
+        // Refine once: the motion from the last registration to this one replaces the prediction; the
+        // frame's pose and stored cloud are at its stamp (first point).
+        const Pose step = last_pose.inverse() * mid_pose;
+        pose = mid_pose * constantVelocity(step, mid - last_stamp, mid)(scan.stamp_ns);
+        deskewed = scan;
+        deskew(deskewed, constantVelocity(step, mid - last_stamp, scan.stamp_ns));
+      } else {
+        pose = mid_pose * T_mid_sensor(scan.stamp_ns);
+      }
+      if (out.registration.ok) {
+        prev_pose = last_pose;
+        prev_stamp = last_stamp;
+        have_prev = have_last;
+        last_pose = mid_pose;
+        last_stamp = mid;
+        have_last = true;
+      }
+    }
+
+    out.frame = tracker.add(scan.sequence, scan.stamp_ns, pose, out.registration.ok);
+    last_failed = !out.registration.ok;
+    last_kind = out.frame.kind;
+    if (!have_last) {  // the first frame: at rest as far as anyone knows
+      last_pose = pose;
+      last_stamp = midSweep(scan);
+      have_last = true;
+    }
+
+    if (out.frame.stored())
+      out.cloud = std::make_shared<const Scan>(
+          toScan(reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_dense_map), scan));
+    // A lost keyframe restarts the local map (upstream); a failed registration does not feed it, unless
+    // registrations keep failing (the map was restarted from a partial sweep, or the vehicle got far off
+    // the prediction): then the map restarts from this frame at its predicted pose.
+    failures_in_a_row = out.registration.ok ? 0 : failures_in_a_row + 1;
+    if (out.frame.isKeyframe() && out.registration.ok) addKeyframe(deskewed, pose, out.frame.lost || !target);
+    else if (failures_in_a_row >= kRestartAfterFailures) {
+      addKeyframe(deskewed, pose, true);
+      failures_in_a_row = 0;
+    }
+    return out;
+  }
+};
+
+Mapper::Mapper(const config::Parameters& params) : impl_(std::make_unique<Impl>(params)) {}
+Mapper::~Mapper() = default;
+MapperOutput Mapper::process(const Scan& scan) { return impl_->process(scan); }
+const FrameTracker& Mapper::tracker() const { return impl_->tracker; }
+bool Mapper::done() const { return impl_->tracker.full(); }
+std::size_t Mapper::localMapPoints() const { return impl_->target ? impl_->target->size() : 0; }
+
+std::shared_ptr<const Scan> Mapper::mapCloud() const {
+  reg::PointCloud merged;
+  for (const auto& k : impl_->all_keyframes)
+    merged.points.insert(merged.points.end(), k.points.begin(), k.points.end());
+  Scan like;
+  like.sensor_id = "map";
+  if (merged.empty()) return std::make_shared<const Scan>(like);
+  return std::make_shared<const Scan>(toScan(reg::voxelDownsample(merged, impl_->params.leaf_size_local_map), like));
+}
+
+}  // namespace rigcal::pipeline

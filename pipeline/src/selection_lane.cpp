@@ -1,0 +1,99 @@
+#include "selection_lane.hpp"
+
+#include <algorithm>
+#include <map>
+
+namespace rigcal::pipeline {
+
+SelectionLane::SelectionLane(std::string mapping_sensor, std::string calibration_sensor, const Pose& T_base_mapping,
+                             const Pose& T_mapping_calib_guess, const config::Parameters& params)
+    : params_(params) {
+  base_.mapping_sensor = std::move(mapping_sensor);
+  base_.calibration_sensor = std::move(calibration_sensor);
+  base_.T_base_mapping = T_base_mapping;
+  base_.T_mapping_calib_guess = T_mapping_calib_guess;
+}
+
+std::shared_ptr<const CalibrationDataset> SelectionLane::add(CandidateMessage candidate, const CloudLookup& clouds) {
+  last_keyframe_ = std::max(last_keyframe_, candidate.keyframe_index);
+  if (handed_over_) return nullptr;  // counted, no longer selected
+  lost_keyframes_ = candidate.lost_keyframes;  // grows with every candidate
+  Record r;
+  const bool selectable = candidate.pairing.accepted && candidate.information >= params_.calibration_min_pca_eigenvalue;
+  if (candidate.pairing.accepted) ++accepted_;
+  if (selectable) {
+    for (std::size_t i = candidate.window_begin; i <= candidate.window_end && i < candidate.frames->size(); ++i) {
+      const MappingFrame& f = (*candidate.frames)[i];
+      if (auto cloud = clouds(i)) r.window.push_back({i, MappingCloud{f, std::move(cloud)}});
+    }
+  }
+  r.c = std::move(candidate);
+  records_.push_back(std::move(r));
+  if (!records_.back().c.pairing.accepted) return nullptr;
+  reselect();
+  if (!selection_.budgetFull(params_)) return nullptr;
+  handed_over_ = true;
+  return dataset(true);
+}
+
+void SelectionLane::reselect() {
+  std::vector<SelectionCandidate> pool;
+  for (std::size_t id = 0; id < records_.size(); ++id) {
+    const CandidateMessage& c = records_[id].c;
+    if (c.pairing.accepted) pool.push_back({id, c.keyframe_index, c.path_length, c.information});
+  }
+  selection_ = selectFrames(pool, lost_keyframes_, params_);
+  // Too flat or near a lost keyframe stays so: those candidates' clouds can go.
+  for (const Rejection& r : selection_.rejected) {
+    Record& rec = records_[r.id];
+    if (rec.c.information < params_.calibration_min_pca_eigenvalue || r.reason.rfind("within ", 0) == 0)
+      rec.window.clear();
+  }
+}
+
+std::shared_ptr<const CalibrationDataset> SelectionLane::finish() {
+  if (handed_over_ || !selection_.enough(params_)) return nullptr;
+  handed_over_ = true;
+  return dataset(false);
+}
+
+std::shared_ptr<const CalibrationDataset> SelectionLane::dataset(bool budget_full) const {
+  auto d = std::make_shared<CalibrationDataset>(base_);
+  d->budget_full = budget_full;
+  for (const Record& r : records_) {
+    d->candidates.push_back(r.c.pairing);
+    if (!r.c.pairing.accepted)
+      d->rejected.push_back({d->candidates.size() - 1, r.c.pairing.rejection});
+  }
+  for (const Rejection& r : selection_.rejected) d->rejected.push_back(r);
+  std::sort(d->rejected.begin(), d->rejected.end(), [](const Rejection& a, const Rejection& b) { return a.id < b.id; });
+  std::map<std::size_t, MappingCloud> window;  // by stored index: in sequence order, each once
+  for (std::size_t id : selection_.selected) {
+    const Record& r = records_[id];
+    d->frames.push_back({r.c.pairing, r.c.raw, r.c.deskewed, r.c.information});
+    for (const auto& [idx, m] : r.window) window.emplace(idx, m);
+  }
+  for (auto& [idx, m] : window) d->mapping_clouds.push_back(m);
+  if (!records_.empty()) d->trajectory = *records_.back().c.frames;
+  return d;
+}
+
+std::optional<std::size_t> SelectionLane::neededFrom(const std::vector<std::size_t>& keyframes) const {
+  if (handed_over_) return std::nullopt;
+  const int first = std::max(0, last_keyframe_ + 1 - params_.dense_pointcloud_num_keyframes);
+  if (std::size_t(first) >= keyframes.size()) return keyframes.empty() ? 0 : keyframes.back();
+  return keyframes[std::size_t(first)];
+}
+
+Shortfall SelectionLane::shortfall() const {
+  Shortfall s;
+  s.sensor = base_.calibration_sensor;
+  s.selected = int(selection_.selected.size());
+  s.required = params_.lidar_calibration_min_frames;
+  s.message = std::to_string(s.selected) + " of " + std::to_string(s.required) + " frames for " + s.sensor +
+              " (" + std::to_string(records_.size()) + " candidates, " + std::to_string(accepted_) +
+              " accepted): drive further or lower lidar_calibration_min_frames";
+  return s;
+}
+
+}  // namespace rigcal::pipeline

@@ -1,0 +1,57 @@
+#pragma once
+// The selector stage's work for one calibration lidar: keeps every candidate pairing, re-runs
+// selectFrames() when an accepted one arrives, and builds the CalibrationDataset once the frame budget
+// is full (or at end of input with at least lidar_calibration_min_frames). Candidates hold their dense
+// window's clouds until they can never be selected.
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pairing_lane.hpp"
+#include "rigcal/pipeline/calibration_dataset.hpp"
+#include "rigcal/pipeline/pipeline.hpp"
+
+namespace rigcal::pipeline {
+
+/// The stored mapping cloud of a stored frame index (nullptr once released).
+using CloudLookup = std::function<std::shared_ptr<const Scan>(std::size_t stored_index)>;
+
+class SelectionLane {
+ public:
+  SelectionLane(std::string mapping_sensor, std::string calibration_sensor, const Pose& T_base_mapping,
+                const Pose& T_mapping_calib_guess, const config::Parameters& params);
+
+  /// Returns the dataset when this candidate fills the budget (once).
+  std::shared_ptr<const CalibrationDataset> add(CandidateMessage candidate, const CloudLookup& clouds);
+  /// End of input: the dataset if enough frames are selected and it was not handed over yet.
+  std::shared_ptr<const CalibrationDataset> finish();
+
+  [[nodiscard]] bool handedOver() const { return handed_over_; }
+  /// The first stored frame a future candidate's window may start at (none once handed over).
+  [[nodiscard]] std::optional<std::size_t> neededFrom(const std::vector<std::size_t>& keyframes) const;
+  [[nodiscard]] std::size_t candidates() const { return records_.size(); }
+  [[nodiscard]] std::size_t accepted() const { return accepted_; }
+  [[nodiscard]] std::size_t selected() const { return selection_.selected.size(); }
+  [[nodiscard]] Shortfall shortfall() const;
+
+ private:
+  struct Record {
+    CandidateMessage c;
+    std::vector<std::pair<std::size_t, MappingCloud>> window;  // by stored index; released when the candidate can never be selected
+  };
+  void reselect();
+  std::shared_ptr<const CalibrationDataset> dataset(bool budget_full) const;
+
+  CalibrationDataset base_;
+  config::Parameters params_;
+  std::vector<Record> records_;
+  std::vector<int> lost_keyframes_;
+  Selection selection_;
+  std::size_t accepted_ = 0;
+  int last_keyframe_ = -1;
+  bool handed_over_ = false;
+};
+
+}  // namespace rigcal::pipeline
