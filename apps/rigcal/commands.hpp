@@ -20,5 +20,6 @@ void addDriverCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
 void addMonitorCommand(CLI::App& app);
 void addSimCommand(CLI::App& app);
+void addCalibrateCommand(CLI::App& app);
 
 }  // namespace rigcal::app

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   addReplayCommand(app);
   addMonitorCommand(app);
   addSimCommand(app);
+  addCalibrateCommand(app);
 
   try {
     app.parse(argc, argv);
