@@ -149,10 +149,21 @@ RgbImage renderOverview(const CalibrationOutcome& o, int panel_size) {
     panels[k].top = header;
     panels[k].size = panel_size;
   }
-  // The inset's feature: the 4 m square holding the most calibrated calibration points.
+  // The inset's feature: the 4 m square holding the most calibrated calibration points above the
+  // ground (walls, poles, cars: where a misalignment shows; the ground rings near the car show nothing).
+  std::vector<double> heights;
+  for (const auto& a : after)
+    for (const auto& p : a) heights.push_back(p.z());
+  double ground = 0.0;
+  if (!heights.empty()) {
+    auto nth = heights.begin() + std::ptrdiff_t(heights.size() / 10);
+    std::nth_element(heights.begin(), nth, heights.end());
+    ground = *nth;
+  }
   std::map<std::pair<long, long>, int> cells;
   for (const auto& a : after)
-    for (const auto& p : a) ++cells[{long(std::floor(p.x() / 4.0)), long(std::floor(p.y() / 4.0))}];
+    for (const auto& p : a)
+      if (p.z() > ground + 0.5) ++cells[{long(std::floor(p.x() / 4.0)), long(std::floor(p.y() / 4.0))}];
   std::pair<long, long> feature{0, 0};
   int most = -1;
   for (const auto& [cell, n] : cells)

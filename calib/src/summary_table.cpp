@@ -11,7 +11,7 @@ std::string row(const std::string& pair, const std::string& result, const Pose& 
   const XyzRpy v = toXyzRpy(T);
   const Pose change = initial.inverse() * T;
   char line[320];
-  std::snprintf(line, sizeof line, "%-26s %-10s %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f  %7.3f %7.3f  %-22s %s\n",
+  std::snprintf(line, sizeof line, "%-26s %-10s %8.3f %8.3f %8.3f %9.3f %9.3f %8.3f  %7.3f %7.3f  %-22s %s\n",
                 pair.c_str(), result.c_str(), v.x, v.y, v.z, rad2deg(v.roll), rad2deg(v.pitch), rad2deg(v.yaw),
                 change.translation().norm(), rad2deg(rotationAngle(change)), score.c_str(), frames.c_str());
   return line;
@@ -22,8 +22,8 @@ std::string row(const std::string& pair, const std::string& result, const Pose& 
 std::string summaryTable(const CalibrationOutcome& o) {
   std::ostringstream out;
   char head[320];
-  std::snprintf(head, sizeof head, "%-26s %-10s %8s %8s %8s %8s %8s %8s  %7s %7s  %-22s %s\n", "parent -> child",
-                "result", "x m", "y m", "z m", "roll°", "pitch°", "yaw°", "Δt m", "Δr °", "score (rms m, inl.)",
+  std::snprintf(head, sizeof head, "%-26s %-10s %8s %8s %8s %9s %9s %8s  %7s %7s  %-22s %s\n", "parent -> child",
+                "result", "x m", "y m", "z m", "roll deg", "pitch deg", "yaw deg", "dt m", "dr deg", "score (rms m, inl.)",
                 "frames");
   out << head;
   const auto initial_base = o.initial_T_base_sensor.count(o.mapping_sensor) != 0
@@ -52,7 +52,7 @@ std::string summaryTable(const CalibrationOutcome& o) {
   for (const auto& r : o.lidars)
     if (!r.ok) out << "  " << r.calibration_sensor << ": " << r.failure << "\n";
   if (o.base && !o.base->ok) out << "  " << o.mapping_sensor << " (base): " << o.base->failure << "\n";
-  out << "  ok (dl) = best result when the deadline (" << o.deadline_s << " s) was reached; Δ = change from the initial guess\n";
+  out << "  ok (dl) = best result when the deadline (" << o.deadline_s << " s) was reached; dt, dr = change from the initial guess\n";
   return out.str();
 }
 

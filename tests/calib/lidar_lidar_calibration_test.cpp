@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
 #include <cmath>
 #include <memory>
 
@@ -11,6 +13,14 @@
 #include "rigcal/calib/calibration_deskew.hpp"
 #include "rigcal/calib/calibration_scheduler.hpp"
 #include "rigcal/calib/calibration_score.hpp"
+#include "rigcal/calib/calibration_yaml_writer.hpp"
+#include "rigcal/calib/cloud_writers.hpp"
+#include "rigcal/calib/overview_png_writer.hpp"
+#include "rigcal/calib/report_json_writer.hpp"
+#include "rigcal/calib/summary_table.hpp"
+#include "rigcal/core/pcd_io.hpp"
+#include "rigcal/registration/evaluator.hpp"
+#include "test_data.hpp"
 #include "rigcal/calib/lidar_lidar_calibration.hpp"
 #include "sanitizers.hpp"
 
@@ -236,6 +246,44 @@ TEST_F(LidarLidarSim, BaseLidarZRollPitchFromTheSimulatedGround) {
   EXPECT_NEAR(got.z, want.z, 0.01);
   EXPECT_NEAR(rad2deg(got.roll), rad2deg(want.roll), 0.05);
   EXPECT_NEAR(rad2deg(got.pitch), rad2deg(want.pitch), 0.05);
+}
+
+TEST_F(LidarLidarSim, OutputsOfARealRunPutTheAfterCloudOnTheMap) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock budget measured in the optimised build only";
+  config::Parameters params = data_->params;
+  params.calibration_deadline_s = 4.0;
+  CalibrationOutcome o;
+  o.rig_name = "sim-parking-lot";
+  o.mapping_sensor = data_->datasets.front().mapping_sensor;
+  o.version = "test";
+  o.deadline_s = params.calibration_deadline_s;
+  o.initial_T_base_sensor[o.mapping_sensor] = data_->truth_T_base_mapping;
+  for (const auto& d : data_->datasets)
+    o.initial_T_base_sensor[d.calibration_sensor] = data_->truth_T_base_mapping * d.T_mapping_calib_guess;
+  o.datasets = data_->datasets;
+  o.lidars = calibrateLidarsLidar(o.datasets, params);
+  test::TempDir dir;
+  // RIGCAL_KEEP_OUTPUTS=<dir>: write there instead, to look at them.
+  const char* keep = std::getenv("RIGCAL_KEEP_OUTPUTS");
+  const std::filesystem::path out = keep != nullptr ? std::filesystem::path(keep) : dir.path();
+  std::filesystem::create_directories(out);
+  writeCalibrationYaml(out / "calibration.yaml", o);
+  writeReportJson(out / "report.json", o);
+  writeCalibrationClouds(out, o);
+  writeOverviewPng(out / "overview.png", o);
+  std::printf("%s", summaryTable(o).c_str());
+  // The after clouds sit on the map far better than the before clouds.
+  const auto map = readPcd(out / "map.pcd");
+  const registration::Target target(registration::fromTable(map));
+  for (const auto& d : o.datasets) {
+    const auto before = registration::evaluate(target, registration::fromTable(readPcd(out / (d.calibration_sensor + "_before.pcd"))),
+                                               Pose::Identity(), 0.1);
+    const auto after = registration::evaluate(target, registration::fromTable(readPcd(out / (d.calibration_sensor + "_after.pcd"))),
+                                              Pose::Identity(), 0.1);
+    std::printf("%s on the map: inliers %.3f -> %.3f\n", d.calibration_sensor.c_str(), before.inlier_ratio, after.inlier_ratio);
+    EXPECT_GT(after.inlier_ratio, before.inlier_ratio + 0.2) << d.calibration_sensor;
+  }
+  EXPECT_GT(std::filesystem::file_size(out / "overview.png"), 10000u);
 }
 
 }  // namespace
