@@ -31,14 +31,18 @@ using Clock = std::chrono::steady_clock;
 
 class LidarLidarSim : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    test::SimDatasetOptions o;
-    o.bump_amplitude_m = 0.0;  // the lot keeps its slope; see SimDatasetOptions for why no bumps
-    if (RIGCAL_SANITIZED) {  // instrumented code runs 10-50x slower: a shorter stretch, fewer frames
-      o.seconds = 7.0;
-      o.frames = 2;
+  /// Simulated on first use (each ctest entry is its own process: a test that skips never pays for it).
+  static const test::SimDatasets& data() {
+    if (!data_) {
+      test::SimDatasetOptions o;
+      o.bump_amplitude_m = 0.0;  // the lot keeps its slope; see SimDatasetOptions for why no bumps
+      if (RIGCAL_SANITIZED) {    // instrumented code runs 10-50x slower: a shorter stretch, fewer frames
+        o.seconds = 6.0;
+        o.frames = 2;
+      }
+      data_ = std::make_unique<test::SimDatasets>(test::buildSimDatasets(o));
     }
-    data_ = std::make_unique<test::SimDatasets>(test::buildSimDatasets(o));
+    return *data_;
   }
   static void TearDownTestSuite() { data_.reset(); }
 
@@ -50,11 +54,11 @@ class LidarLidarSim : public ::testing::Test {
 std::unique_ptr<test::SimDatasets> LidarLidarSim::data_;
 
 TEST_F(LidarLidarSim, EachCalibrationLidarWithinOneCentimetreAndFiveHundredthsOfADegree) {
-  config::Parameters params = data_->params;
+  config::Parameters params = data().params;
   params.calibration_deadline_s = RIGCAL_SANITIZED ? 600.0 : 60.0;  // accuracy, not the budget, is tested here
-  ASSERT_EQ(data_->datasets.size(), 2u);
-  for (const auto& d : data_->datasets) {
-    const Pose truth = data_->truth_T_mapping_calib.at(d.calibration_sensor);
+  ASSERT_EQ(data().datasets.size(), 2u);
+  for (const auto& d : data().datasets) {
+    const Pose truth = data().truth_T_mapping_calib.at(d.calibration_sensor);
     ASSERT_NEAR(translationError(d.T_mapping_calib_guess, truth), 0.3, 1e-9);
     ASSERT_NEAR(rotationErrorDeg(d.T_mapping_calib_guess, truth), 5.0, 1e-6);
     LidarLidarOptions quick;  // the exhaustive pass only spends leftover time; accuracy comes before it
@@ -82,8 +86,9 @@ TEST_F(LidarLidarSim, EachCalibrationLidarWithinOneCentimetreAndFiveHundredthsOf
 }
 
 TEST_F(LidarLidarSim, RepeatedRunsGiveIdenticalResults) {
-  config::Parameters params = data_->params;
-  auto d = data_->datasets.front();
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
+  config::Parameters params = data().params;
+  auto d = data().datasets.front();
   d.frames.resize(2);  // half the work: determinism does not need every frame
   const auto deadline = registration::Deadline::after(std::chrono::seconds(600));
   LidarLidarOptions two_threads, one_thread;
@@ -102,8 +107,8 @@ TEST_F(LidarLidarSim, RepeatedRunsGiveIdenticalResults) {
 
 TEST_F(LidarLidarSim, OneSecondDeadlineReturnsTheBestSoFarInTime) {
   if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock bound measured in the optimised build only";
-  config::Parameters params = data_->params;
-  const auto& d = data_->datasets.front();
+  config::Parameters params = data().params;
+  const auto& d = data().datasets.front();
   const auto start = Clock::now();
   const auto r = calibrateLidarLidar(d, params, registration::Deadline::after(std::chrono::seconds(1)));
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
@@ -117,16 +122,16 @@ TEST_F(LidarLidarSim, OneSecondDeadlineReturnsTheBestSoFarInTime) {
   EXPECT_TRUE(r.deadline_reached);
   EXPECT_TRUE(r.ok) << r.failure;  // the best so far already beats the guess
   EXPECT_TRUE(r.T_mapping_calib.matrix().allFinite());
-  const Pose truth = data_->truth_T_mapping_calib.at(d.calibration_sensor);
+  const Pose truth = data().truth_T_mapping_calib.at(d.calibration_sensor);
   EXPECT_LT(translationError(r.T_mapping_calib, truth), translationError(d.T_mapping_calib_guess, truth));
 }
 
 TEST_F(LidarLidarSim, SeveralLidarsShareTheDeadlineFairly) {
   if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock bound measured in the optimised build only";
-  config::Parameters params = data_->params;
+  config::Parameters params = data().params;
   params.calibration_deadline_s = 2.0;
   const auto start = Clock::now();
-  const auto results = calibrateLidarsLidar(data_->datasets, params);
+  const auto results = calibrateLidarsLidar(data().datasets, params);
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   ASSERT_EQ(results.size(), 2u);
   std::printf("2 lidars, 2 s: %.3f s total; %s %.3f s, %s %.3f s\n", elapsed, results[0].calibration_sensor.c_str(),
@@ -153,8 +158,8 @@ TEST(CalibrationBudget, SharesWhatIsLeftEquallyAndHandsOnUnusedTime) {
 }
 
 TEST_F(LidarLidarSim, BadInputsGiveClearOneLineErrors) {
-  const config::Parameters params = data_->params;
-  const auto& good = data_->datasets.front();
+  const config::Parameters params = data().params;
+  const auto& good = data().datasets.front();
   const auto failWith = [&](pipeline::CalibrationDataset d, const std::string& needle) {
     const auto r = calibrateLidarLidar(d, params, registration::Deadline::after(std::chrono::seconds(5)));
     EXPECT_FALSE(r.ok);
@@ -210,10 +215,11 @@ TEST(CalibrationScore, FiniteWhenNothingCorresponds) {
 }
 
 TEST_F(LidarLidarSim, RedeskewWithTheTrueExtrinsicMatchesTheTruth) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
   // The dataset's sweeps were deskewed with the wrong guess; with the truth the same raw sweep must
   // move differently than with the guess, and the two deskews must agree at the sweep start.
-  const auto& d = data_->datasets.front();
-  const Pose truth = data_->truth_T_mapping_calib.at(d.calibration_sensor);
+  const auto& d = data().datasets.front();
+  const Pose truth = data().truth_T_mapping_calib.at(d.calibration_sensor);
   const auto& raw = *d.frames.back().raw;
   const Scan with_truth = deskewThroughMapping(raw, d.trajectory, truth);
   const Scan with_guess = deskewThroughMapping(raw, d.trajectory, d.T_mapping_calib_guess);
@@ -231,14 +237,15 @@ TEST_F(LidarLidarSim, RedeskewWithTheTrueExtrinsicMatchesTheTruth) {
 }
 
 TEST_F(LidarLidarSim, BaseLidarZRollPitchFromTheSimulatedGround) {
-  config::Parameters params = data_->params;
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
+  config::Parameters params = data().params;
   params.base_lidar_max_inlier_distance = 0.03;  // 2 cm range noise and 4 cm bumps
   // The ground near the car: the lot's 1.2 % slope and bumps bend the plane further out.
   params.base_lidar_crop_box_min_x = params.base_lidar_crop_box_min_y = -8.0;
   params.base_lidar_crop_box_max_x = params.base_lidar_crop_box_max_y = 8.0;
-  const Pose truth = data_->truth_T_base_mapping;
+  const Pose truth = data().truth_T_base_mapping;
   const Pose guess = test::perturb(truth, 0.3, 5.0, 99);
-  const auto r = calibrateBaseLidar(data_->ground_cloud_mapping, guess, params);
+  const auto r = calibrateBaseLidar(data().ground_cloud_mapping, guess, params);
   ASSERT_TRUE(r.ok) << r.failure;
   const XyzRpy got = toXyzRpy(r.T_base_lidar), want = toXyzRpy(truth);
   std::printf("base-lidar: z %.4f (truth %.4f), roll %.4f deg (%.4f), pitch %.4f deg (%.4f)\n", got.z, want.z,
@@ -250,17 +257,17 @@ TEST_F(LidarLidarSim, BaseLidarZRollPitchFromTheSimulatedGround) {
 
 TEST_F(LidarLidarSim, OutputsOfARealRunPutTheAfterCloudOnTheMap) {
   if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock budget measured in the optimised build only";
-  config::Parameters params = data_->params;
+  config::Parameters params = data().params;
   params.calibration_deadline_s = 4.0;
   CalibrationOutcome o;
   o.rig_name = "sim-parking-lot";
-  o.mapping_sensor = data_->datasets.front().mapping_sensor;
+  o.mapping_sensor = data().datasets.front().mapping_sensor;
   o.version = "test";
   o.deadline_s = params.calibration_deadline_s;
-  o.initial_T_base_sensor[o.mapping_sensor] = data_->truth_T_base_mapping;
-  for (const auto& d : data_->datasets)
-    o.initial_T_base_sensor[d.calibration_sensor] = data_->truth_T_base_mapping * d.T_mapping_calib_guess;
-  o.datasets = data_->datasets;
+  o.initial_T_base_sensor[o.mapping_sensor] = data().truth_T_base_mapping;
+  for (const auto& d : data().datasets)
+    o.initial_T_base_sensor[d.calibration_sensor] = data().truth_T_base_mapping * d.T_mapping_calib_guess;
+  o.datasets = data().datasets;
   o.lidars = calibrateLidarsLidar(o.datasets, params);
   test::TempDir dir;
   // RIGCAL_KEEP_OUTPUTS=<dir>: write there instead, to look at them.
