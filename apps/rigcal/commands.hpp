@@ -23,5 +23,6 @@ void addSimCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addCalibratePoseCommand(CLI::App& app);
+void addCalibrateCommand(CLI::App& app);
 
 }  // namespace rigcal::app

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   addMapCommand(app);
   addCompareCommand(app);
   addCalibratePoseCommand(app);
+  addCalibrateCommand(app);
 
   try {
     app.parse(argc, argv);

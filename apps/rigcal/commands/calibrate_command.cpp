@@ -1,0 +1,249 @@
+// `rigcal calibrate --config RIG (--pcap F | --live) [--out DIR] [--deadline S] [--realtime]`: the main
+// job. Mapping starts at once; each calibration lidar is calibrated (on its own thread, while mapping goes
+// on) as soon as its frame budget is full, the others at the end of input; then base-lidar calibration,
+// the outputs in --out, and a summary table. Ctrl-C ends the input early and calibrates what has enough
+// frames; a lidar without enough frames is named with what is missing (exit 5, partial report).
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <iostream>
+#include <mutex>
+#include <thread>
+
+#include "../commands.hpp"
+#include "../exit_codes.hpp"
+#include "../stop_signals.hpp"
+#include "rigcal/calib/base_lidar_calibration.hpp"
+#include "rigcal/calib/calibration_outcome.hpp"
+#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_yaml_writer.hpp"
+#include "rigcal/calib/cloud_writers.hpp"
+#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/overview_png_writer.hpp"
+#include "rigcal/calib/report_json_writer.hpp"
+#include "rigcal/calib/summary_table.hpp"
+#include "rigcal/config/config_error.hpp"
+#include "rigcal/config/rig_config.hpp"
+#include "rigcal/pipeline/pipeline.hpp"
+
+namespace rigcal::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct CalibrateOptions {
+  std::string config, pcap, out = "rigcal-out";
+  bool live = false, realtime = false;
+  double deadline = -1.0;  // < 0: the rig's calibration_deadline_s
+};
+
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// Calibrates the datasets the pipeline hands over, on its own thread, while mapping goes on. Datasets
+/// that arrive together share one calibration_deadline_s (CalibrationBudget).
+class CalibrationWorker {
+ public:
+  explicit CalibrationWorker(const config::Parameters& params) : params_(params), thread_([this] { loop(); }) {}
+  ~CalibrationWorker() { finish(); }
+  CalibrationWorker(const CalibrationWorker&) = delete;
+  CalibrationWorker& operator=(const CalibrationWorker&) = delete;
+
+  void add(std::shared_ptr<const pipeline::CalibrationDataset> d) {
+    {
+      const std::lock_guard lock(mutex_);
+      pending_.push_back(std::move(d));
+    }
+    wake_.notify_one();
+  }
+  /// Waits until every dataset handed over is calibrated.
+  void finish() {
+    {
+      const std::lock_guard lock(mutex_);
+      done_ = true;
+    }
+    wake_.notify_one();
+    if (thread_.joinable()) thread_.join();
+  }
+  /// After finish().
+  std::vector<pipeline::CalibrationDataset> datasets;
+  std::vector<calib::LidarLidarResult> results;
+  double seconds = 0.0;
+
+ private:
+  void loop() {
+    for (;;) {
+      std::vector<std::shared_ptr<const pipeline::CalibrationDataset>> batch;
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [&] { return done_ || !pending_.empty(); });
+        if (pending_.empty()) return;
+        batch.assign(pending_.begin(), pending_.end());
+        pending_.clear();
+      }
+      const auto t0 = Clock::now();
+      calib::CalibrationBudget budget(t0, params_.calibration_deadline_s, batch.size());
+      for (const auto& d : batch) {
+        results.push_back(calib::calibrateLidarLidar(*d, params_, budget.next()));
+        datasets.push_back(*d);
+      }
+      seconds += since(t0);
+    }
+  }
+
+  config::Parameters params_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::shared_ptr<const pipeline::CalibrationDataset>> pending_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
+void run(const CalibrateOptions& o) {
+  const auto t_start = Clock::now();
+  config::RigConfig rig;
+  try {
+    rig = config::loadRigConfig(o.config);
+  } catch (const config::ConfigError& e) {
+    throw CommandFailed(kExitConfig, e.what());
+  }
+  if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
+  if (!o.live && !std::filesystem::is_regular_file(o.pcap))
+    throw CommandFailed(kExitInput, o.pcap + ": no such capture file");
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec) throw CommandFailed(kExitInput, o.out + ": cannot create the output folder (" + ec.message() + ")");
+
+  pipeline::PipelineOptions po;
+  po.input = o.live ? pipeline::InputKind::kLive : pipeline::InputKind::kPcap;
+  po.pcap = o.pcap;
+  po.rate = o.realtime ? 1.0 : 0.0;
+  po.mode = (o.live || o.realtime) ? pipeline::PipelineMode::kRealtime : pipeline::PipelineMode::kOffline;
+
+  StopSignals signals;
+  CalibrationWorker worker(rig.parameters);
+  std::unique_ptr<pipeline::Pipeline> pipe;
+  try {
+    pipe = std::make_unique<pipeline::Pipeline>(rig, po, [&](std::shared_ptr<const pipeline::CalibrationDataset> d) {
+      worker.add(std::move(d));
+    });
+  } catch (const std::exception& e) {
+    throw CommandFailed(kExitInput, e.what());
+  }
+  // A one-line progress display, on a terminal only.
+  std::atomic<bool> input_done{false};
+  std::thread progress;
+  if (::isatty(STDERR_FILENO) != 0)
+    progress = std::thread([&] {
+      while (!input_done.load()) {
+        std::fprintf(stderr, "\r\033[K%s", pipe->progress().line().c_str());
+        std::fflush(stderr);
+        for (int i = 0; i < 5 && !input_done.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+      std::fprintf(stderr, "\r\033[K");
+    });
+  try {
+    pipe->run(StopSignals::flag());
+  } catch (const std::exception& e) {
+    input_done = true;
+    if (progress.joinable()) progress.join();
+    throw CommandFailed(kExitInput, e.what());
+  }
+  input_done = true;
+  if (progress.joinable()) progress.join();
+  const double pipeline_seconds = since(t_start);
+  const bool interrupted = StopSignals::requested();
+  worker.finish();
+
+  calib::CalibrationOutcome outcome;
+  outcome.rig_name = rig.name;
+  outcome.base_frame = rig.roles.base_frame;
+  outcome.mapping_sensor = rig.roles.mapping_lidar;
+  outcome.version = RIGCAL_VERSION;
+  outcome.initial_T_base_sensor = rig.initial_T_base_sensor;
+  outcome.deadline_s = rig.parameters.calibration_deadline_s;
+  outcome.datasets = worker.datasets;
+  outcome.lidars = worker.results;
+
+  // Base-lidar: the dense cloud around the last keyframe, in that keyframe's lidar frame.
+  const auto t_base = Clock::now();
+  const pipeline::MappingResult mapping = pipe->mapping();
+  if (rig.parameters.calibrate_base_frame && mapping.dense_cloud != nullptr && mapping.last_keyframe_frame >= 0) {
+    const Pose T_lidar_map = mapping.trajectory.at(std::size_t(mapping.last_keyframe_frame)).T_map_lidar.inverse();
+    std::vector<Eigen::Vector3d> points;
+    const Scan& s = *mapping.dense_cloud;
+    points.reserve(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) points.push_back(T_lidar_map * Eigen::Vector3d(s.x[i], s.y[i], s.z[i]));
+    outcome.base = calib::calibrateBaseLidar(points, mapping.T_base_mapping, rig.parameters);
+  }
+  const double base_seconds = since(t_base);
+
+  const auto progress_now = pipe->progress();
+  outcome.input_summary = {{"source", o.live ? std::string("live") : o.pcap},
+                           {"mode", o.live || o.realtime ? "realtime" : "offline"},
+                           {"mapping_scans", std::to_string(progress_now.mapping_scans)},
+                           {"keyframes", std::to_string(progress_now.keyframes)},
+                           {"lost_frames", std::to_string(progress_now.lost_frames)},
+                           {"interrupted", interrupted ? "yes" : "no"}};
+  for (const auto& l : progress_now.lidars)
+    outcome.input_summary.emplace_back(l.sensor + "_scans", std::to_string(l.scans));
+  outcome.stage_seconds = {{"pipeline", pipeline_seconds}, {"lidar_lidar", worker.seconds}, {"base_lidar", base_seconds}};
+
+  const auto shortfalls = pipe->shortfalls();
+  for (const auto& sf : shortfalls) outcome.input_summary.emplace_back(sf.sensor + "_missing", sf.message);
+  const std::filesystem::path out(o.out);
+  const auto t_out = Clock::now();
+  try {
+    calib::writeCalibrationYaml(out / "calibration.yaml", outcome);
+    if (!outcome.datasets.empty()) {
+      calib::writeCalibrationClouds(out, outcome);
+      calib::writeOverviewPng(out / "overview.png", outcome);
+    }
+    outcome.stage_seconds.emplace_back("outputs", since(t_out));
+    calib::writeReportJson(out / "report.json", outcome);
+  } catch (const std::exception& e) {
+    throw CommandFailed(kExitFailure, e.what());
+  }
+  std::cout << calib::summaryTable(outcome) << "outputs in " << out.string() << "\n";
+
+  if (!shortfalls.empty()) {
+    std::string msg = shortfalls.front().message;
+    for (std::size_t i = 1; i < shortfalls.size(); ++i) msg += "; " + shortfalls[i].message;
+    throw CommandFailed(interrupted && outcome.lidars.empty() ? kExitInterrupted : kExitNotEnoughData,
+                        msg + " (partial report in " + (out / "report.json").string() + ")");
+  }
+  if (outcome.lidars.empty() && !rig.roles.calibration_lidars.empty())
+    throw CommandFailed(interrupted ? kExitInterrupted : kExitNotEnoughData,
+                        "no calibration lidar got a dataset: no packets from " + rig.roles.calibration_lidars.front() +
+                            "? (partial report in " + (out / "report.json").string() + ")");
+  for (const auto& r : outcome.lidars)
+    if (!r.ok) throw CommandFailed(kExitFailure, r.calibration_sensor + ": " + r.failure);
+  if (outcome.base && !outcome.base->ok) throw CommandFailed(kExitFailure, "base-lidar: " + outcome.base->failure);
+}
+
+}  // namespace
+
+void addCalibrateCommand(CLI::App& app) {
+  auto o = std::make_shared<CalibrateOptions>();
+  CLI::App* cmd = app.add_subcommand("calibrate", "Map with the mapping lidar and calibrate the rig (the main job).");
+  cmd->add_option("--config", o->config, "rig YAML file")->required()->check(CLI::ExistingFile);
+  auto* pcap = cmd->add_option("--pcap", o->pcap, "read this pcap/pcapng capture");
+  auto* live = cmd->add_flag("--live", o->live, "listen on the sensors' UDP ports");
+  pcap->excludes(live);
+  live->excludes(pcap);
+  cmd->add_option("--out", o->out, "output folder (default rigcal-out)");
+  cmd->add_option("--deadline", o->deadline, "seconds for the lidar-lidar calibration (calibration_deadline_s)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--realtime", o->realtime, "replay the pcap at its recorded rate (real-time pipeline)");
+  cmd->footer(kExitCodesHelp);
+  cmd->callback([o, cmd] {
+    if (o->pcap.empty() && !o->live) throw CLI::RequiredError("--pcap or --live");
+    (void)cmd;
+    run(*o);
+  });
+}
+
+}  // namespace rigcal::app

@@ -1,0 +1,49 @@
+#pragma once
+// The target side of a lidar-lidar registration: the mapping lidar's "augmented" cloud around a selected
+// keyframe. Every stored mapping frame between keyframes kid−N and kid+N (N = dense_pointcloud_num_keyframes)
+// is expressed in the mapping-lidar frame interpolated at the calibration scan's stamp, voxelised at
+// leaf_size_dense_map and cropped to the source's bounding box (under the initial extrinsic) widened by
+// |t_initial|, then built once into a registration Target (tree, covariances, NDT grid).
+#include <cstddef>
+#include <memory>
+#include <optional>
+
+#include "rigcal/config/parameters.hpp"
+#include "rigcal/pipeline/calibration_dataset.hpp"
+#include "rigcal/registration/point_cloud.hpp"
+#include "rigcal/registration/target.hpp"
+
+namespace rigcal::calib {
+
+struct AugmentedTargetOptions {
+  /// At most this many mapping clouds per target, evenly spread over the window (always keeping the
+  /// keyframe's own): a stored frame every few centimetres of path gives ~150 clouds per window, most
+  /// of them redundant after voxelising; 0 = all.
+  std::size_t max_clouds = 12;
+  double ndt_resolution = 1.0;  // the ensemble's NDT grid
+  int num_threads = 1;
+};
+
+struct AugmentedTarget {
+  std::shared_ptr<const registration::Target> target;  // in the mapping frame at the scan stamp
+  std::size_t clouds_used = 0;
+  std::size_t points_before_voxel = 0;  // after the crop
+};
+
+/// Which dataset.mapping_clouds form the window of dataset.frames[frame] (indices, by sequence).
+/// Throws std::invalid_argument when the frame's keyframe is not a keyframe of dataset.trajectory.
+std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                      const config::Parameters& params, std::size_t max_clouds);
+
+/// The augmented cloud of dataset.frames[frame] (before building the Target), cropped around `source`
+/// placed by the dataset's initial extrinsic.
+registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                        const registration::PointCloud& source, const config::Parameters& params,
+                                        const AugmentedTargetOptions& options, std::size_t* clouds_used = nullptr,
+                                        std::size_t* points_before_voxel = nullptr);
+
+AugmentedTarget buildAugmentedTarget(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                     const registration::PointCloud& source, const config::Parameters& params,
+                                     const AugmentedTargetOptions& options = {});
+
+}  // namespace rigcal::calib

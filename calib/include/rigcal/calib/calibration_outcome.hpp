@@ -1,0 +1,38 @@
+#pragma once
+// Everything one calibration run produced, in one place for the writers (calibration.yaml, report.json,
+// clouds, overview.png, the stdout summary).
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rigcal/calib/base_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/core/pose.hpp"
+#include "rigcal/pipeline/calibration_dataset.hpp"
+
+namespace rigcal::calib {
+
+struct CalibrationOutcome {
+  std::string rig_name;
+  std::string base_frame = "base_link";
+  std::string mapping_sensor;
+  std::string version;                                // rigcal's
+  std::map<std::string, Pose> initial_T_base_sensor;  // every sensor of the rig, from its config
+  std::optional<BaseLidarResult> base;                // when base-lidar calibration ran
+  std::vector<pipeline::CalibrationDataset> datasets; // one per calibration lidar (may lack a result)
+  std::vector<LidarLidarResult> lidars;               // one per dataset that was calibrated
+  double deadline_s = 0.0;
+  std::vector<std::pair<std::string, double>> stage_seconds;  // whole-run stages (pipeline, calibration, outputs)
+  std::vector<std::pair<std::string, std::string>> input_summary;  // source, scans, keyframes, ...
+
+  /// T_base_mapping: the base-lidar result when it succeeded, else the initial one.
+  [[nodiscard]] Pose T_base_mapping() const;
+  /// Every sensor's T_base_sensor: calibrated where a calibration succeeded, else initial.
+  [[nodiscard]] std::map<std::string, Pose> T_base_sensor() const;
+  /// The lidar-lidar result of `sensor`, or nullptr.
+  [[nodiscard]] const LidarLidarResult* lidar(const std::string& sensor) const;
+};
+
+}  // namespace rigcal::calib

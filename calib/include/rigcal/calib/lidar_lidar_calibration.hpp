@@ -1,0 +1,73 @@
+#pragma once
+// Lidar-lidar calibration of one calibration lidar against the mapping lidar's dense map, from the
+// pipeline's CalibrationDataset, in bounded time. See ensemble_plan.hpp for the order of the work,
+// calibration_score.hpp for the score, augmented_target.hpp / calibration_source.hpp for the clouds.
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rigcal/calib/augmented_target.hpp"
+#include "rigcal/calib/calibration_score.hpp"
+#include "rigcal/config/parameters.hpp"
+#include "rigcal/core/pose.hpp"
+#include "rigcal/pipeline/calibration_dataset.hpp"
+#include "rigcal/registration/deadline.hpp"
+
+namespace rigcal::calib {
+
+struct LidarLidarOptions {
+  int num_threads = 2;                // per registration, target build and score (results do not depend on it)
+  AugmentedTargetOptions target;      // its num_threads is overridden by the one above
+  std::size_t score_points = 60000;   // points (over all frames) the all-frames score looks at
+  bool redeskew = true;               // re-deskew with the calibrated extrinsic before the final registration
+  /// After the quick passes and the final refinement, spend the time left on upstream's exhaustive
+  /// ensemble (every registrator from every candidate on every frame). Off: finish as soon as refined.
+  bool exhaustive = true;
+};
+
+/// One registration the ensemble ran (for report.json).
+struct RegistratorRun {
+  int frame = -1;             // dataset frame index; −1 = batched over all frames
+  std::string registrator;    // ndt, gicp, icp_coarse, icp_fine, icp_ultra_fine, batched_icp
+  double max_distance = 0.0;  // correspondence distance (m)
+  std::size_t start = 0;      // index into LidarLidarResult::candidates it started from
+  double seconds = 0.0;
+  int iterations = 0;
+  std::string status;
+  double frame_score = -1.0;  // its own frame's score (m²); −1 = not computed (batched, or out of time)
+  double score = -1.0;        // all-frames score (m²); −1 = not computed (not its frame's best)
+};
+
+struct LidarLidarResult {
+  std::string mapping_sensor;
+  std::string calibration_sensor;
+  bool ok = false;               // the result beats the initial guess's score
+  std::string failure;           // one line when !ok
+  bool deadline_reached = false; // stopped by the deadline (or a cancel): the best so far
+  Pose T_mapping_calib_guess = Pose::Identity();
+  Pose T_mapping_calib = Pose::Identity();  // the best found (the guess when nothing beat it)
+  CalibrationScore initial_score;
+  CalibrationScore final_score;
+  std::vector<std::size_t> frames_used;       // dataset frame indices that had a target
+  std::vector<std::string> frames_skipped;    // "frame 3: <why>"
+  std::vector<Pose> candidates;               // [0] = the initial guess
+  std::vector<RegistratorRun> runs;
+  std::vector<std::pair<std::string, double>> stage_seconds;  // targets, ensemble, batched, redeskew+final
+  double seconds = 0.0;
+};
+
+/// Empty when `dataset` can be calibrated, else one line naming the field that is wrong.
+std::string validateDataset(const pipeline::CalibrationDataset& dataset, const config::Parameters& params);
+
+/// Never throws for bad data: an invalid dataset gives ok = false with the reason. Stops by `deadline`.
+LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
+                                     const registration::Deadline& deadline, const LidarLidarOptions& options = {});
+
+/// Several calibration lidars sharing params.calibration_deadline_s from now (see CalibrationBudget).
+std::vector<LidarLidarResult> calibrateLidarsLidar(const std::vector<pipeline::CalibrationDataset>& datasets,
+                                                   const config::Parameters& params,
+                                                   const registration::CancelToken* cancel = nullptr,
+                                                   const LidarLidarOptions& options = {});
+
+}  // namespace rigcal::calib

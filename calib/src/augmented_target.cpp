@@ -1,0 +1,108 @@
+#include "rigcal/calib/augmented_target.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "rigcal/registration/voxel_grid.hpp"
+
+namespace rigcal::calib {
+
+std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                      const config::Parameters& params, std::size_t max_clouds) {
+  const auto& pairing = dataset.frames.at(frame).pairing;
+  if (pairing.keyframe_frame >= dataset.trajectory.size() ||
+      dataset.trajectory[pairing.keyframe_frame].keyframe_index < 0) {
+    std::ostringstream msg;
+    msg << "calibration frame " << frame << ": keyframe_frame " << pairing.keyframe_frame
+        << " is not a keyframe of the mapping trajectory (" << dataset.trajectory.size() << " frames)";
+    throw std::invalid_argument(msg.str());
+  }
+  const auto& keyframe = dataset.trajectory[pairing.keyframe_frame];
+  const int lo = keyframe.keyframe_index - params.dense_pointcloud_num_keyframes;
+  const int hi = keyframe.keyframe_index + params.dense_pointcloud_num_keyframes;
+  // The window's sequence range: from keyframe lo (or the start) to keyframe hi (or the end).
+  std::uint64_t seq_lo = 0, seq_hi = std::numeric_limits<std::uint64_t>::max();
+  for (const auto& f : dataset.trajectory) {
+    if (f.keyframe_index == lo) seq_lo = f.sequence;
+    if (f.keyframe_index == hi) seq_hi = f.sequence;
+  }
+  std::vector<std::size_t> window;
+  std::size_t own = std::numeric_limits<std::size_t>::max();
+  for (std::size_t i = 0; i < dataset.mapping_clouds.size(); ++i) {
+    const auto& c = dataset.mapping_clouds[i];
+    if (c.cloud == nullptr || c.frame.sequence < seq_lo || c.frame.sequence > seq_hi) continue;
+    if (c.frame.sequence == keyframe.sequence) own = window.size();
+    window.push_back(i);
+  }
+  if (max_clouds == 0 || window.size() <= max_clouds) return window;
+  // Evenly spread picks, the keyframe's own cloud always among them.
+  std::vector<std::size_t> picked;
+  const std::size_t gaps = std::max<std::size_t>(max_clouds - 1, 1);
+  for (std::size_t k = 0; k < max_clouds; ++k) picked.push_back(window[k * (window.size() - 1) / gaps]);
+  if (own < window.size() && std::find(picked.begin(), picked.end(), window[own]) == picked.end()) {
+    // Replace the nearest pick by the keyframe's own cloud.
+    auto nearest = std::min_element(picked.begin(), picked.end(), [&](std::size_t a, std::size_t b) {
+      const auto da = a > window[own] ? a - window[own] : window[own] - a;
+      const auto db = b > window[own] ? b - window[own] : window[own] - b;
+      return da < db;
+    });
+    *nearest = window[own];
+  }
+  std::sort(picked.begin(), picked.end());
+  picked.erase(std::unique(picked.begin(), picked.end()), picked.end());
+  return picked;
+}
+
+registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                        const registration::PointCloud& source, const config::Parameters& params,
+                                        const AugmentedTargetOptions& options, std::size_t* clouds_used,
+                                        std::size_t* points_before_voxel) {
+  const auto window = targetWindow(dataset, frame, params, options.max_clouds);
+  // Crop box: the source under the initial extrinsic, widened by |t_initial| (the guess may be that far off).
+  const Pose& guess = dataset.T_mapping_calib_guess;
+  Eigen::Vector3d box_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d box_max = -box_min;
+  for (const auto& p : source.points) {
+    const Eigen::Vector3d q = guess * p.head<3>();
+    box_min = box_min.cwiseMin(q);
+    box_max = box_max.cwiseMax(q);
+  }
+  const double margin = guess.translation().norm();
+  box_min.array() -= margin;
+  box_max.array() += margin;
+
+  const Pose T_scan_map = dataset.frames[frame].pairing.T_map_mapping_at_scan.inverse();
+  registration::PointCloud cropped;
+  for (const std::size_t i : window) {
+    const auto& mc = dataset.mapping_clouds[i];
+    const Eigen::Matrix4f T = (T_scan_map * mc.frame.T_map_lidar).matrix().cast<float>();
+    const Scan& s = *mc.cloud;
+    for (std::size_t j = 0; j < s.size(); ++j) {
+      const Eigen::Vector4f q = T * Eigen::Vector4f(s.x[j], s.y[j], s.z[j], 1.0F);
+      const Eigen::Vector3d qd = q.head<3>().cast<double>();
+      if ((qd.array() < box_min.array()).any() || (qd.array() > box_max.array()).any()) continue;  // NaN fails too
+      cropped.add(qd.x(), qd.y(), qd.z());
+    }
+  }
+  if (clouds_used != nullptr) *clouds_used = window.size();
+  if (points_before_voxel != nullptr) *points_before_voxel = cropped.size();
+  if (cropped.empty()) return cropped;
+  return registration::voxelDownsample(cropped, params.leaf_size_dense_map);
+}
+
+AugmentedTarget buildAugmentedTarget(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                     const registration::PointCloud& source, const config::Parameters& params,
+                                     const AugmentedTargetOptions& options) {
+  AugmentedTarget out;
+  auto cloud = augmentedCloud(dataset, frame, source, params, options, &out.clouds_used, &out.points_before_voxel);
+  registration::TargetOptions to;
+  to.normals_and_covariances = true;
+  to.ndt_resolutions = {options.ndt_resolution};
+  to.num_threads = options.num_threads;
+  out.target = std::make_shared<const registration::Target>(std::move(cloud), to);
+  return out;
+}
+
+}  // namespace rigcal::calib

@@ -1,0 +1,59 @@
+#include "rigcal/calib/summary_table.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+namespace rigcal::calib {
+namespace {
+
+std::string row(const std::string& pair, const std::string& result, const Pose& T, const Pose& initial,
+                const std::string& score, const std::string& frames) {
+  const XyzRpy v = toXyzRpy(T);
+  const Pose change = initial.inverse() * T;
+  char line[320];
+  std::snprintf(line, sizeof line, "%-26s %-10s %8.3f %8.3f %8.3f %9.3f %9.3f %8.3f  %7.3f %7.3f  %-22s %s\n",
+                pair.c_str(), result.c_str(), v.x, v.y, v.z, rad2deg(v.roll), rad2deg(v.pitch), rad2deg(v.yaw),
+                change.translation().norm(), rad2deg(rotationAngle(change)), score.c_str(), frames.c_str());
+  return line;
+}
+
+}  // namespace
+
+std::string summaryTable(const CalibrationOutcome& o) {
+  std::ostringstream out;
+  char head[320];
+  std::snprintf(head, sizeof head, "%-26s %-10s %8s %8s %8s %9s %9s %8s  %7s %7s  %-22s %s\n", "parent -> child",
+                "result", "x m", "y m", "z m", "roll deg", "pitch deg", "yaw deg", "dt m", "dr deg", "score (rms m, inl.)",
+                "frames");
+  out << head;
+  const auto initial_base = o.initial_T_base_sensor.count(o.mapping_sensor) != 0
+                                ? o.initial_T_base_sensor.at(o.mapping_sensor)
+                                : Pose::Identity();
+  if (o.base) {
+    char score[64];
+    std::snprintf(score, sizeof score, "plane %zu inliers", o.base->plane.inliers);
+    out << row(o.base_frame + " -> " + o.mapping_sensor, o.base->ok ? "ok" : "FAILED", o.T_base_mapping(),
+               initial_base, o.base->ok ? score : o.base->failure, "-");
+  }
+  for (const auto& d : o.datasets) {
+    const LidarLidarResult* r = o.lidar(d.calibration_sensor);
+    const std::string pair = d.mapping_sensor + " -> " + d.calibration_sensor;
+    if (r == nullptr) {
+      out << row(pair, "not run", d.T_mapping_calib_guess, d.T_mapping_calib_guess, "-",
+                 std::to_string(d.frames.size()) + " selected");
+      continue;
+    }
+    char score[96];
+    std::snprintf(score, sizeof score, "%.4f, %.2f", r->final_score.rmse, r->final_score.inlier_ratio);
+    const std::string result = !r->ok ? "FAILED" : r->deadline_reached ? "ok (dl)" : "ok";
+    out << row(pair, result, r->ok ? r->T_mapping_calib : r->T_mapping_calib_guess, r->T_mapping_calib_guess, score,
+               std::to_string(r->frames_used.size()) + "/" + std::to_string(d.frames.size()));
+  }
+  for (const auto& r : o.lidars)
+    if (!r.ok) out << "  " << r.calibration_sensor << ": " << r.failure << "\n";
+  if (o.base && !o.base->ok) out << "  " << o.mapping_sensor << " (base): " << o.base->failure << "\n";
+  out << "  ok (dl) = best result when the deadline (" << o.deadline_s << " s) was reached; dt, dr = change from the initial guess\n";
+  return out.str();
+}
+
+}  // namespace rigcal::calib

@@ -1,0 +1,297 @@
+// Lidar-lidar calibration on simulator data (tests/calib/lidar_lidar_sim_dataset.*): accuracy from a
+// 0.3 m / 5° guess, determinism, the deadline, several lidars sharing it, and bad input.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <cmath>
+#include <memory>
+
+#include "lidar_lidar_sim_dataset.hpp"
+#include "rigcal/calib/base_lidar_calibration.hpp"
+#include "rigcal/calib/calibration_deskew.hpp"
+#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_score.hpp"
+#include "rigcal/calib/calibration_yaml_writer.hpp"
+#include "rigcal/calib/cloud_writers.hpp"
+#include "rigcal/calib/overview_png_writer.hpp"
+#include "rigcal/calib/report_json_writer.hpp"
+#include "rigcal/calib/summary_table.hpp"
+#include "rigcal/core/pcd_io.hpp"
+#include "rigcal/registration/evaluator.hpp"
+#include "test_data.hpp"
+#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "sanitizers.hpp"
+
+namespace rigcal::calib {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+class LidarLidarSim : public ::testing::Test {
+ protected:
+  /// Simulated on first use (each ctest entry is its own process: a test that skips never pays for it).
+  static const test::SimDatasets& data() {
+    if (!data_) {
+      test::SimDatasetOptions o;
+      o.bump_amplitude_m = 0.0;  // the lot keeps its slope; see SimDatasetOptions for why no bumps
+      if (RIGCAL_SANITIZED) {    // instrumented code runs 10-50x slower: a shorter stretch, fewer frames
+        o.seconds = 6.0;
+        o.frames = 2;
+      }
+      data_ = std::make_unique<test::SimDatasets>(test::buildSimDatasets(o));
+    }
+    return *data_;
+  }
+  static void TearDownTestSuite() { data_.reset(); }
+
+  static double translationError(const Pose& a, const Pose& b) { return (a.translation() - b.translation()).norm(); }
+  static double rotationErrorDeg(const Pose& a, const Pose& b) { return rad2deg(rotationAngleBetween(a, b)); }
+
+  static std::unique_ptr<test::SimDatasets> data_;
+};
+std::unique_ptr<test::SimDatasets> LidarLidarSim::data_;
+
+TEST_F(LidarLidarSim, EachCalibrationLidarWithinOneCentimetreAndFiveHundredthsOfADegree) {
+  config::Parameters params = data().params;
+  params.calibration_deadline_s = RIGCAL_SANITIZED ? 600.0 : 60.0;  // accuracy, not the budget, is tested here
+  ASSERT_EQ(data().datasets.size(), 2u);
+  for (const auto& d : data().datasets) {
+    const Pose truth = data().truth_T_mapping_calib.at(d.calibration_sensor);
+    ASSERT_NEAR(translationError(d.T_mapping_calib_guess, truth), 0.3, 1e-9);
+    ASSERT_NEAR(rotationErrorDeg(d.T_mapping_calib_guess, truth), 5.0, 1e-6);
+    LidarLidarOptions quick;  // the exhaustive pass only spends leftover time; accuracy comes before it
+    quick.exhaustive = false;
+    const auto r = calibrateLidarLidar(d, params, registration::Deadline::after(std::chrono::seconds(600)), quick);
+    ASSERT_TRUE(r.ok) << d.calibration_sensor << ": " << r.failure;
+    EXPECT_FALSE(r.deadline_reached);
+    EXPECT_EQ(r.frames_used.size(), d.frames.size());
+    EXPECT_LT(r.final_score.value, r.initial_score.value);
+    EXPECT_TRUE(std::isfinite(r.final_score.value));
+    const double dt = translationError(r.T_mapping_calib, truth);
+    const double dr = rotationErrorDeg(r.T_mapping_calib, truth);
+    std::printf("%s: error %.4f m %.4f deg, score %.6f -> %.6f m2 (inliers %.3f -> %.3f), %.2f s, %zu runs\n",
+                d.calibration_sensor.c_str(), dt, dr, r.initial_score.value, r.final_score.value,
+                r.initial_score.inlier_ratio, r.final_score.inlier_ratio, r.seconds, r.runs.size());
+    for (const auto& [stage, seconds] : r.stage_seconds) std::printf("  %s %.3f s\n", stage.c_str(), seconds);
+    if (!RIGCAL_SANITIZED) {
+      EXPECT_LT(dt, 0.01) << d.calibration_sensor;
+      EXPECT_LT(dr, 0.05) << d.calibration_sensor;
+    } else {  // two frames only
+      EXPECT_LT(dt, 0.03) << d.calibration_sensor;
+      EXPECT_LT(dr, 0.15) << d.calibration_sensor;
+    }
+  }
+}
+
+TEST_F(LidarLidarSim, RepeatedRunsGiveIdenticalResults) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
+  config::Parameters params = data().params;
+  auto d = data().datasets.front();
+  d.frames.resize(2);  // half the work: determinism does not need every frame
+  const auto deadline = registration::Deadline::after(std::chrono::seconds(600));
+  LidarLidarOptions two_threads, one_thread;
+  two_threads.exhaustive = one_thread.exhaustive = false;  // a run that ends by itself, not by the clock
+  one_thread.num_threads = 1;
+  const auto a = calibrateLidarLidar(d, params, deadline, two_threads);
+  const auto b = calibrateLidarLidar(d, params, deadline, one_thread);
+  ASSERT_TRUE(a.ok) << a.failure;
+  ASSERT_FALSE(a.deadline_reached);
+  ASSERT_FALSE(b.deadline_reached);
+  EXPECT_TRUE(a.T_mapping_calib.matrix() == b.T_mapping_calib.matrix())
+      << a.T_mapping_calib.matrix() << "\nvs\n" << b.T_mapping_calib.matrix();
+  EXPECT_EQ(a.final_score.value, b.final_score.value);
+  EXPECT_EQ(a.runs.size(), b.runs.size());
+}
+
+TEST_F(LidarLidarSim, OneSecondDeadlineReturnsTheBestSoFarInTime) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock bound measured in the optimised build only";
+  config::Parameters params = data().params;
+  const auto& d = data().datasets.front();
+  const auto start = Clock::now();
+  const auto r = calibrateLidarLidar(d, params, registration::Deadline::after(std::chrono::seconds(1)));
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  std::printf("1 s deadline: returned after %.3f s, deadline_reached %d, ok %d, %zu runs, score %.6f -> %.6f\n",
+              elapsed, int(r.deadline_reached), int(r.ok), r.runs.size(), r.initial_score.value, r.final_score.value);
+  for (const auto& [stage, seconds] : r.stage_seconds) std::printf("  %s %.3f s\n", stage.c_str(), seconds);
+  for (const auto& run : r.runs)
+    std::printf("  %s frame %d: %.3f s, %s, frame score %.6f\n", run.registrator.c_str(), run.frame, run.seconds,
+                run.status.c_str(), run.frame_score);
+  EXPECT_LT(elapsed, 1.05);
+  EXPECT_TRUE(r.deadline_reached);
+  EXPECT_TRUE(r.ok) << r.failure;  // the best so far already beats the guess
+  EXPECT_TRUE(r.T_mapping_calib.matrix().allFinite());
+  const Pose truth = data().truth_T_mapping_calib.at(d.calibration_sensor);
+  EXPECT_LT(translationError(r.T_mapping_calib, truth), translationError(d.T_mapping_calib_guess, truth));
+}
+
+TEST_F(LidarLidarSim, SeveralLidarsShareTheDeadlineFairly) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock bound measured in the optimised build only";
+  config::Parameters params = data().params;
+  params.calibration_deadline_s = 2.0;
+  const auto start = Clock::now();
+  const auto results = calibrateLidarsLidar(data().datasets, params);
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  ASSERT_EQ(results.size(), 2u);
+  std::printf("2 lidars, 2 s: %.3f s total; %s %.3f s, %s %.3f s\n", elapsed, results[0].calibration_sensor.c_str(),
+              results[0].seconds, results[1].calibration_sensor.c_str(), results[1].seconds);
+  EXPECT_LT(elapsed, 2.1);
+  for (const auto& r : results) {
+    EXPECT_TRUE(r.ok) << r.calibration_sensor << ": " << r.failure;
+    EXPECT_GT(r.seconds, 0.5) << "each lidar gets about half of the budget";
+  }
+}
+
+TEST(CalibrationBudget, SharesWhatIsLeftEquallyAndHandsOnUnusedTime) {
+  const auto start = Clock::now();
+  CalibrationBudget budget(start, 3.0, 3);
+  const auto first = budget.next();
+  EXPECT_NEAR(std::chrono::duration<double>(first.when() - start).count(), 1.0, 0.05);
+  const auto second = budget.next();  // the first lidar used ~nothing: the rest is split in two
+  EXPECT_NEAR(std::chrono::duration<double>(second.when() - start).count(), 1.5, 0.05);
+  const auto third = budget.next();
+  EXPECT_NEAR(std::chrono::duration<double>(third.when() - start).count(), 3.0, 0.05);
+  CalibrationBudget unlimited(start, 0.0, 2);
+  EXPECT_FALSE(unlimited.limited());
+  EXPECT_FALSE(unlimited.next().expired());
+}
+
+TEST_F(LidarLidarSim, BadInputsGiveClearOneLineErrors) {
+  const config::Parameters params = data().params;
+  const auto& good = data().datasets.front();
+  const auto failWith = [&](pipeline::CalibrationDataset d, const std::string& needle) {
+    const auto r = calibrateLidarLidar(d, params, registration::Deadline::after(std::chrono::seconds(5)));
+    EXPECT_FALSE(r.ok);
+    EXPECT_NE(r.failure.find(needle), std::string::npos) << r.failure;
+    EXPECT_EQ(r.failure.find('\n'), std::string::npos);
+    EXPECT_TRUE(r.T_mapping_calib.matrix().allFinite());
+  };
+  auto d = good;
+  d.frames.clear();
+  failWith(d, "no selected calibration frames");
+  d = good;
+  d.frames.resize(1);
+  failWith(d, "1 of 2 frames");
+  d = good;
+  d.T_mapping_calib_guess.translation().x() = std::nan("");
+  failWith(d, "T_mapping_calib_guess");
+  d = good;
+  d.frames[1].raw.reset();
+  failWith(d, "frames[1] has no raw scan");
+  d = good;
+  d.frames[0].pairing.keyframe_frame = d.trajectory.size() + 3;
+  failWith(d, "frames[0].pairing.keyframe_frame");
+  d = good;
+  d.trajectory.resize(1);
+  failWith(d, "fewer than two poses");
+  d = good;
+  d.mapping_clouds.clear();
+  failWith(d, "no mapping clouds");
+  // Clouds that do not overlap at all: every frame is skipped, no NaN, a failure that says why.
+  d = good;
+  for (auto& f : d.frames) {
+    auto far = std::make_shared<Scan>(*f.deskewed);
+    for (auto& z : far->z) z += 5000.0F;
+    f.deskewed = far;
+  }
+  failWith(d, "no calibration frame has a usable source and target");
+}
+
+TEST(CalibrationScore, FiniteWhenNothingCorresponds) {
+  registration::PointCloud target_cloud, source;
+  for (int i = 0; i < 200; ++i) {
+    target_cloud.add(i * 0.1, 0, 0);
+    source.add(i * 0.1, 100, 0);
+  }
+  const registration::Target target(target_cloud);
+  const auto s = scoreFrame(target, source, Pose::Identity(), 0.1);
+  EXPECT_TRUE(std::isfinite(s.value));
+  EXPECT_DOUBLE_EQ(s.value, 0.01);  // every point costs d_max²
+  EXPECT_EQ(s.inliers, 0u);
+  const auto aligned = scoreFrame(target, source, Pose(Eigen::Translation3d(0, -100, 0)), 0.1);
+  EXPECT_TRUE(aligned.betterThan(s));
+  EXPECT_EQ(aligned.inliers, 200u);
+}
+
+TEST_F(LidarLidarSim, RedeskewWithTheTrueExtrinsicMatchesTheTruth) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
+  // The dataset's sweeps were deskewed with the wrong guess; with the truth the same raw sweep must
+  // move differently than with the guess, and the two deskews must agree at the sweep start.
+  const auto& d = data().datasets.front();
+  const Pose truth = data().truth_T_mapping_calib.at(d.calibration_sensor);
+  const auto& raw = *d.frames.back().raw;
+  const Scan with_truth = deskewThroughMapping(raw, d.trajectory, truth);
+  const Scan with_guess = deskewThroughMapping(raw, d.trajectory, d.T_mapping_calib_guess);
+  ASSERT_EQ(with_truth.size(), raw.size());
+  double max_diff = 0.0, first_diff = 0.0;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const double diff = std::hypot(with_truth.x[i] - with_guess.x[i], with_truth.y[i] - with_guess.y[i],
+                                   with_truth.z[i] - with_guess.z[i]);
+    max_diff = std::max(max_diff, diff);
+    if (raw.offset_ns[i] < 100'000) first_diff = std::max(first_diff, diff);
+  }
+  EXPECT_GT(max_diff, 1e-3);   // the guess's lever arm bends the sweep differently
+  EXPECT_LT(first_diff, 1e-3); // both are exact at the reference time
+  EXPECT_THROW(mappingPoseAt({}, 0), std::invalid_argument);
+}
+
+TEST_F(LidarLidarSim, BaseLidarZRollPitchFromTheSimulatedGround) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
+  config::Parameters params = data().params;
+  params.base_lidar_max_inlier_distance = 0.03;  // 2 cm range noise and 4 cm bumps
+  // The ground near the car: the lot's 1.2 % slope and bumps bend the plane further out.
+  params.base_lidar_crop_box_min_x = params.base_lidar_crop_box_min_y = -8.0;
+  params.base_lidar_crop_box_max_x = params.base_lidar_crop_box_max_y = 8.0;
+  const Pose truth = data().truth_T_base_mapping;
+  const Pose guess = test::perturb(truth, 0.3, 5.0, 99);
+  const auto r = calibrateBaseLidar(data().ground_cloud_mapping, guess, params);
+  ASSERT_TRUE(r.ok) << r.failure;
+  const XyzRpy got = toXyzRpy(r.T_base_lidar), want = toXyzRpy(truth);
+  std::printf("base-lidar: z %.4f (truth %.4f), roll %.4f deg (%.4f), pitch %.4f deg (%.4f)\n", got.z, want.z,
+              rad2deg(got.roll), rad2deg(want.roll), rad2deg(got.pitch), rad2deg(want.pitch));
+  EXPECT_NEAR(got.z, want.z, 0.01);
+  EXPECT_NEAR(rad2deg(got.roll), rad2deg(want.roll), 0.05);
+  EXPECT_NEAR(rad2deg(got.pitch), rad2deg(want.pitch), 0.05);
+}
+
+TEST_F(LidarLidarSim, OutputsOfARealRunPutTheAfterCloudOnTheMap) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock budget measured in the optimised build only";
+  config::Parameters params = data().params;
+  params.calibration_deadline_s = 4.0;
+  CalibrationOutcome o;
+  o.rig_name = "sim-parking-lot";
+  o.mapping_sensor = data().datasets.front().mapping_sensor;
+  o.version = "test";
+  o.deadline_s = params.calibration_deadline_s;
+  o.initial_T_base_sensor[o.mapping_sensor] = data().truth_T_base_mapping;
+  for (const auto& d : data().datasets)
+    o.initial_T_base_sensor[d.calibration_sensor] = data().truth_T_base_mapping * d.T_mapping_calib_guess;
+  o.datasets = data().datasets;
+  o.lidars = calibrateLidarsLidar(o.datasets, params);
+  test::TempDir dir;
+  // RIGCAL_KEEP_OUTPUTS=<dir>: write there instead, to look at them.
+  const char* keep = std::getenv("RIGCAL_KEEP_OUTPUTS");
+  const std::filesystem::path out = keep != nullptr ? std::filesystem::path(keep) : dir.path();
+  std::filesystem::create_directories(out);
+  writeCalibrationYaml(out / "calibration.yaml", o);
+  writeReportJson(out / "report.json", o);
+  writeCalibrationClouds(out, o);
+  writeOverviewPng(out / "overview.png", o);
+  std::printf("%s", summaryTable(o).c_str());
+  // The after clouds sit on the map far better than the before clouds.
+  const auto map = readPcd(out / "map.pcd");
+  const registration::Target target(registration::fromTable(map));
+  for (const auto& d : o.datasets) {
+    const auto before = registration::evaluate(target, registration::fromTable(readPcd(out / (d.calibration_sensor + "_before.pcd"))),
+                                               Pose::Identity(), 0.1);
+    const auto after = registration::evaluate(target, registration::fromTable(readPcd(out / (d.calibration_sensor + "_after.pcd"))),
+                                              Pose::Identity(), 0.1);
+    std::printf("%s on the map: inliers %.3f -> %.3f\n", d.calibration_sensor.c_str(), before.inlier_ratio, after.inlier_ratio);
+    EXPECT_GT(after.inlier_ratio, before.inlier_ratio + 0.2) << d.calibration_sensor;
+  }
+  EXPECT_GT(std::filesystem::file_size(out / "overview.png"), 10000u);
+}
+
+}  // namespace
+}  // namespace rigcal::calib
