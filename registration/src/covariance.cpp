@@ -24,8 +24,6 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
   }
   cloud.normals.assign(n, Eigen::Vector4d::Zero());
   cloud.covariances.assign(n, Eigen::Matrix4d::Zero());
-  Eigen::Matrix3d plane = Eigen::Matrix3d::Zero();
-  plane.diagonal() << options.plane_epsilon, 1.0, 1.0;  // eigenvalues come smallest first
   std::atomic<std::size_t> isolated{0};
 
   parallelFor(chunkCount(n, kDefaultChunk), options.num_threads, [&](std::size_t task) {
@@ -68,9 +66,10 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
       cov /= static_cast<double>(found);
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
       eig.computeDirect(cov);
-      const Eigen::Matrix3d& U = eig.eigenvectors();
-      cloud.covariances[i].topLeftCorner<3, 3>() = U * plane * U.transpose();
-      Eigen::Vector3d normal = U.col(0);
+      // U·diag(ε, 1, 1)·Uᵀ = I − (1 − ε)·n·nᵀ for orthonormal U: only the normal is needed.
+      Eigen::Vector3d normal = eig.eigenvectors().col(0);
+      cloud.covariances[i].topLeftCorner<3, 3>() =
+          Eigen::Matrix3d::Identity() - (1.0 - options.plane_epsilon) * (normal * normal.transpose());
       if (normal.dot(cloud.points[i].head<3>()) > 0.0) normal = -normal;  // face the sensor at the origin
       cloud.normals[i].head<3>() = normal;
     }
