@@ -122,6 +122,12 @@ json reportJson(const CalibrationOutcome& o) {
   if (o.base) {
     json b = {{"ok", o.base->ok}, {"cropped_points", o.base->cropped_points}};
     if (!o.base->ok) b["failure"] = o.base->failure;
+    if (o.base->keyframes_tried > 0)
+      b["keyframes"] = {{"tried", o.base->keyframes_tried},
+                        {"used", o.base->keyframes_used},
+                        {"spread_z_m", o.base->spread_z},
+                        {"spread_roll_deg", o.base->spread_roll_deg},
+                        {"spread_pitch_deg", o.base->spread_pitch_deg}};
     b["result"] = xyzRpy(o.base->T_base_lidar);
     b["plane"] = {{"normal", {o.base->plane.normal.x(), o.base->plane.normal.y(), o.base->plane.normal.z()}},
                   {"d", o.base->plane.d},

@@ -18,6 +18,7 @@
 #include "../exit_codes.hpp"
 #include "../stop_signals.hpp"
 #include "rigcal/calib/base_lidar_calibration.hpp"
+#include "rigcal/calib/base_lidar_multi.hpp"
 #include "rigcal/calib/calibration_outcome.hpp"
 #include "rigcal/calib/calibration_scheduler.hpp"
 #include "rigcal/calib/calibration_yaml_writer.hpp"
@@ -168,16 +169,19 @@ void run(const CalibrateOptions& o) {
   outcome.datasets = worker.datasets;
   outcome.lidars = worker.results;
 
-  // Base-lidar: the dense cloud around the last keyframe, in that keyframe's lidar frame.
+  // Base-lidar: the ground fitted at keyframes spread along the path (the map in each keyframe's lidar
+  // frame) and combined: on bumpy ground one keyframe's plane carries the body's tilt at that spot.
   const auto t_base = Clock::now();
   const pipeline::MappingResult mapping = pipe->mapping();
-  if (rig.parameters.calibrate_base_frame && mapping.dense_cloud != nullptr && mapping.last_keyframe_frame >= 0) {
-    const Pose T_lidar_map = mapping.trajectory.at(std::size_t(mapping.last_keyframe_frame)).T_map_lidar.inverse();
+  if (rig.parameters.calibrate_base_frame && mapping.map_cloud != nullptr && mapping.last_keyframe_frame >= 0) {
+    std::vector<Pose> keyframes;
+    for (const auto& f : mapping.trajectory)
+      if (f.keyframe_index >= 0 && !f.lost) keyframes.push_back(f.T_map_lidar);
     std::vector<Eigen::Vector3d> points;
-    const Scan& s = *mapping.dense_cloud;
+    const Scan& s = *mapping.map_cloud;
     points.reserve(s.size());
-    for (std::size_t i = 0; i < s.size(); ++i) points.push_back(T_lidar_map * Eigen::Vector3d(s.x[i], s.y[i], s.z[i]));
-    outcome.base = calib::calibrateBaseLidar(points, mapping.T_base_mapping, rig.parameters);
+    for (std::size_t i = 0; i < s.size(); ++i) points.emplace_back(s.x[i], s.y[i], s.z[i]);
+    outcome.base = calib::calibrateBaseLidarMulti(points, keyframes, mapping.T_base_mapping, rig.parameters);
   }
   const double base_seconds = since(t_base);
 

@@ -16,6 +16,11 @@ struct BaseLidarResult {
   Pose T_base_lidar = Pose::Identity();
   GroundPlane plane;            // in the lidar frame
   std::size_t cropped_points = 0;
+  /// Filled by calibrateBaseLidarMulti: ground fits tried and accepted, and the accepted estimates'
+  /// median absolute deviation from the combined one (z in metres, roll and pitch in degrees).
+  std::size_t keyframes_tried = 0;
+  std::size_t keyframes_used = 0;
+  double spread_z = 0.0, spread_roll_deg = 0.0, spread_pitch_deg = 0.0;
 };
 
 /// T_base_lidar from the ground plane. The plane gives the ground pose in the lidar frame (origin: the

@@ -1,0 +1,134 @@
+// Base-lidar calibration over many keyframes on the simulator's bumpy parking lot: the median of the
+// per-keyframe ground fits must recover the mounting's z, roll and pitch where one keyframe cannot
+// (the body rests on its wheels, so its tilt over the local ground follows the bumps).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "lidar_lidar_sim_dataset.hpp"
+#include "rigcal/calib/base_lidar_multi.hpp"
+#include "sanitizers.hpp"
+
+namespace rigcal {
+namespace {
+
+struct Errors {
+  double z = 0, roll_deg = 0, pitch_deg = 0;
+};
+
+Errors errorsOf(const Pose& estimate, const Pose& truth) {
+  const XyzRpy e = toXyzRpy(estimate), t = toXyzRpy(truth);
+  return {std::abs(e.z - t.z), rad2deg(std::abs(e.roll - t.roll)), rad2deg(std::abs(e.pitch - t.pitch))};
+}
+
+class BaseLidarMultiTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    test::SimDatasetOptions o;  // the preset's 4 cm bumps every 5 m and 1.2 % slope
+    o.frames = 2;
+    o.seconds = 12.0;  // under three bump periods: shorter stretches do not average them out
+    data_ = std::make_unique<test::SimDatasets>(test::buildSimDatasets(o));
+    const auto& d = data_->datasets.front();
+    for (const auto& c : d.mapping_clouds) {
+      const Scan& s = *c.cloud;
+      for (std::size_t j = 0; j < s.size(); j += RIGCAL_SANITIZED ? 4 : 1)
+        map_.push_back(c.frame.T_map_lidar * Eigen::Vector3d(s.x[j], s.y[j], s.z[j]));
+    }
+    for (const auto& f : d.trajectory)
+      if (f.keyframe_index >= 0) keyframes_.push_back(f.T_map_lidar);
+  }
+  static void TearDownTestSuite() {
+    data_.reset();
+    map_.clear();
+    keyframes_.clear();
+  }
+
+  static std::unique_ptr<test::SimDatasets> data_;
+  static std::vector<Eigen::Vector3d> map_;
+  static std::vector<Pose> keyframes_;
+};
+
+std::unique_ptr<test::SimDatasets> BaseLidarMultiTest::data_;
+std::vector<Eigen::Vector3d> BaseLidarMultiTest::map_;
+std::vector<Pose> BaseLidarMultiTest::keyframes_;
+
+TEST_F(BaseLidarMultiTest, MedianOverKeyframesBeatsOneKeyframeOnBumps) {
+  ASSERT_GE(keyframes_.size(), 6u);
+  const Pose truth = data_->truth_T_base_mapping;
+  const Pose guess = test::perturb(truth, 0.05, 1.0, 3);
+  config::Parameters p = data_->params;
+  calib::BaseLidarMultiSettings s;
+  s.max_points_per_fit = RIGCAL_SANITIZED ? 8000 : 30000;  // keeps the test short; the command fits more
+
+  // Every keyframe on its own: the spread the bumps cause.
+  Errors worst;
+  for (const auto& kf : keyframes_) {
+    const auto one = calib::calibrateBaseLidarMulti(map_, {kf}, guess, p, s);
+    ASSERT_TRUE(one.ok) << one.failure;
+    const Errors e = errorsOf(one.T_base_lidar, truth);
+    worst = {std::max(worst.z, e.z), std::max(worst.roll_deg, e.roll_deg), std::max(worst.pitch_deg, e.pitch_deg)};
+  }
+
+  const auto all = calib::calibrateBaseLidarMulti(map_, keyframes_, guess, p, s);
+  ASSERT_TRUE(all.ok) << all.failure;
+  EXPECT_EQ(all.keyframes_tried, std::min(keyframes_.size(), s.max_keyframes));
+  EXPECT_EQ(all.keyframes_used, all.keyframes_tried);
+  const Errors e = errorsOf(all.T_base_lidar, truth);
+  std::printf("%zu keyframes: worst single |dz| %.4f m roll %.3f° pitch %.3f°; combined |dz| %.4f m roll %.3f° "
+              "pitch %.3f°; spread z %.4f m roll %.3f° pitch %.3f°\n",
+              all.keyframes_used, worst.z, worst.roll_deg, worst.pitch_deg, e.z, e.roll_deg, e.pitch_deg,
+              all.spread_z, all.spread_roll_deg, all.spread_pitch_deg);
+  // The issue asks 1 cm / 0.05° on the whole parking-lot drive (24 keyframes, several bump periods);
+  // this 12 s stretch covers under three bump periods, so the bounds here are looser: the combined
+  // estimate must halve the worst single keyframe's error and stay within 1.5 cm / 0.15°.
+  EXPECT_LT(e.z, 0.015);
+  EXPECT_LT(e.roll_deg, 0.15);
+  EXPECT_LT(e.pitch_deg, 0.15);
+  EXPECT_LT(e.z, 0.5 * worst.z);
+  EXPECT_LT(std::max(e.roll_deg, e.pitch_deg), 0.5 * std::max(worst.roll_deg, worst.pitch_deg));
+  EXPECT_TRUE(std::isfinite(all.spread_z) && std::isfinite(all.spread_pitch_deg));
+}
+
+// The map holds the ground under the car at each keyframe (seen before it drove there): cropping to the
+// footprint fits the plane the wheels rest on, so the bumps drop out of each estimate, not only the median.
+TEST_F(BaseLidarMultiTest, FootprintCropMeetsTheIssueTargets) {
+  const Pose truth = data_->truth_T_base_mapping;
+  const Pose guess = test::perturb(truth, 0.05, 1.0, 3);
+  config::Parameters p = data_->params;
+  p.base_lidar_crop_box_min_x = -1.5;  // around the car (base_link at its centre), at ground level
+  p.base_lidar_crop_box_max_x = 4.0;
+  p.base_lidar_crop_box_min_y = -1.5;
+  p.base_lidar_crop_box_max_y = 1.5;
+  p.base_lidar_crop_box_min_z = -1.0;
+  p.base_lidar_crop_box_max_z = 0.5;
+  if (RIGCAL_SANITIZED) p.base_lidar_min_plane_points = 300;  // the map is thinned 4x there
+  const auto all = calib::calibrateBaseLidarMulti(map_, keyframes_, guess, p);
+  ASSERT_TRUE(all.ok) << all.failure;
+  const Errors e = errorsOf(all.T_base_lidar, truth);
+  std::printf("footprint crop, %zu keyframes: |dz| %.4f m roll %.3f° pitch %.3f°\n", all.keyframes_used, e.z,
+              e.roll_deg, e.pitch_deg);
+  EXPECT_GE(all.keyframes_used, all.keyframes_tried / 2);
+  EXPECT_LT(e.z, 0.01);
+  EXPECT_LT(e.roll_deg, 0.05);
+  EXPECT_LT(e.pitch_deg, 0.05);
+}
+
+TEST_F(BaseLidarMultiTest, NoKeyframeOrNoGroundFailsWithAMessage) {
+  const Pose truth = data_->truth_T_base_mapping;
+  const auto none = calib::calibrateBaseLidarMulti(map_, {}, truth, data_->params);
+  EXPECT_FALSE(none.ok);
+  EXPECT_NE(none.failure.find("no keyframe"), std::string::npos);
+  config::Parameters p = data_->params;
+  p.base_lidar_crop_box_min_z = 50.0;  // nothing in the box
+  p.base_lidar_crop_box_max_z = 60.0;
+  const auto empty = calib::calibrateBaseLidarMulti(map_, keyframes_, truth, p);
+  EXPECT_FALSE(empty.ok);
+  EXPECT_EQ(empty.keyframes_used, 0u);
+  EXPECT_NE(empty.failure.find("no ground plane"), std::string::npos) << empty.failure;
+}
+
+}  // namespace
+}  // namespace rigcal
