@@ -122,7 +122,7 @@ void run(const CompareOptions& o) {
   };
   std::cout << std::left;
   const auto row = [](const std::string& a, const std::string& b, const std::string& c) {
-    std::cout << "  " << std::setw(10) << a << std::setw(52) << b << c << "\n";
+    std::cout << "  " << std::setw(10) << a << std::setw(52) << b << "  " << c << "\n";
   };
   std::cout << "truth " << o.truth << "\nresult " << o.result << "\n";
 
