@@ -27,7 +27,10 @@ void shops(const Side& side, ObjectBuilder& build, Placer& place, Rng& rng) {
     const Eigen::Vector2d c = side.at(s + 0.5 * len, setback + 0.5 * depth);
     const Rect2 fp = rotatedRect(c, side.yaw(), len, depth);
     if (len > 8 && place.free(fp)) {
-      place.occupy(build.building(c, side.yaw(), len, depth, int(rng.uniformInt(1, 4)), rng.chance(0.35)));
+      // Draws in separate statements: argument evaluation order is unspecified (compilers differ).
+      const bool l_shape = rng.chance(0.35);
+      const int floors = int(rng.uniformInt(1, 4));
+      place.occupy(build.building(c, side.yaw(), len, depth, floors, l_shape));
       // Bollards guarding the shop front.
       const int n = int(rng.uniformInt(0, 5));
       const double d = setback + depth + rng.uniform(1.8, 2.6), s0 = s + rng.uniform(2, len * 0.5);
@@ -126,8 +129,10 @@ void stallRows(const SceneSpec& spec, ObjectBuilder& build, Placer& place, Rng& 
         if (place.clearOfPath(rotatedRect(line, M_PI_2, stall_d, 0.12))) build.paint(line, M_PI_2, stall_d, 0.12);
         if (!rng.chance(0.62)) continue;
         // Parked nose-in or reversed in, a little off-centre and askew, as people park.
-        const double yaw = (rng.chance(0.7) ? side : -side) * M_PI_2 + rng.uniform(-0.06, 0.06);
-        const Eigen::Vector2d c = stall + Eigen::Vector2d(rng.uniform(-0.15, 0.15), side * rng.uniform(-0.2, 0.1));
+        const double facing = rng.chance(0.7) ? side : -side;
+        const double yaw = facing * M_PI_2 + rng.uniform(-0.06, 0.06);
+        const double off_y = side * rng.uniform(-0.2, 0.1), off_x = rng.uniform(-0.15, 0.15);
+        const Eigen::Vector2d c = stall + Eigen::Vector2d(off_x, off_y);
         const Rect2 fp = rotatedRect(c, yaw, 4.9, 1.9);
         if (place.free(fp, 0.05)) place.occupy(build.car(c, yaw));
       }
@@ -164,7 +169,8 @@ void layoutParkingLot(const SceneSpec& spec, ObjectBuilder& build, Placer& place
   }
   // A few free-standing trees and signs scattered over the lot's margins.
   for (int k = 0; k < 10; ++k) {
-    const Eigen::Vector2d p(rng.uniform(lo.x() + 6, hi.x() - 6), rng.uniform(lo.y() + 6, hi.y() - 6));
+    const double py = rng.uniform(lo.y() + 6, hi.y() - 6), px = rng.uniform(lo.x() + 6, hi.x() - 6);
+    const Eigen::Vector2d p(px, py);
     const Rect2 r{p.x() - 3, p.y() - 3, p.x() + 3, p.y() + 3};
     if (!place.free(r)) continue;
     place.occupy(k % 3 == 0 ? build.sign(p, rng.uniform(0, 2 * M_PI)) : build.tree(p));

@@ -69,8 +69,12 @@ void sideOfStreet(const CentreLine& line, double side, double curb, double cross
     if (std::abs(mid - crossing) > 0.5 * len + 8) {
       const Eigen::Vector2d c = off(mid, d);
       const double yaw = line.yaw(mid) + (side > 0 ? M_PI : 0);  // front faces the street
-      if (place.free(rotatedRect(c, yaw, len, depth), 0.2))
-        place.occupy(build.building(c, yaw, len, depth, int(rng.uniformInt(2, 5)), rng.chance(0.3)));
+      if (place.free(rotatedRect(c, yaw, len, depth), 0.2)) {
+        // Draws in separate statements: argument evaluation order is unspecified (compilers differ).
+        const bool l_shape = rng.chance(0.3);
+        const int floors = int(rng.uniformInt(2, 5));
+        place.occupy(build.building(c, yaw, len, depth, floors, l_shape));
+      }
     }
     s += len + (rng.chance(0.4) ? rng.uniform(3, 7) : 0.6);
   }

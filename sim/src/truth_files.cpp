@@ -109,8 +109,10 @@ void writePosesCsv(const Simulation& sim, const std::filesystem::path& file) {
     if (t > sim.endTime()) break;
     Pose T = sim.T_world_base(t) * p.T_base_pose;
     if (p.position_noise_m > 0 || p.rotation_noise_deg > 0) {
-      const Eigen::Vector3d dp(rng.normal(), rng.normal(), rng.normal());
-      const Eigen::Vector3d dr(rng.normal(), rng.normal(), rng.normal());
+      // One draw per statement: the order of function arguments is unspecified (compilers differ).
+      const double pz = rng.normal(), py = rng.normal(), px = rng.normal();
+      const double rz = rng.normal(), ry = rng.normal(), rx = rng.normal();
+      const Eigen::Vector3d dp(px, py, pz), dr(rx, ry, rz);
       T.translation() += p.position_noise_m * dp;
       T.linear() = T.linear() * expSO3(deg2rad(p.rotation_noise_deg) * dr);
     }
