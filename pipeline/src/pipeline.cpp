@@ -523,15 +523,18 @@ struct Pipeline::Impl {
     stages.emplace_back("selector", options.cores, [this] { selectorStage(); });
   }
 
+  // Stops the driver threads / ring readers and waits for them (caller holds finish_mutex).
+  void stopSources() {
+    source_stop.store(true);
+    lead_cv.notify_all();
+    std::lock_guard sources_lock(sources_mutex);
+    for (auto& s : sources) s.join();
+  }
+
   void finish() {
     std::lock_guard lock(finish_mutex);
     if (finished) return;
-    source_stop.store(true);
-    lead_cv.notify_all();
-    {
-      std::lock_guard sources_lock(sources_mutex);
-      for (auto& s : sources) s.join();
-    }
+    stopSources();
     for (const auto& r : readers) ring_overruns += r->stats().overruns + r->stats().torn_reads;
     endOfInput();
     for (auto& s : stages) s.join();
@@ -543,12 +546,7 @@ struct Pipeline::Impl {
     {
       std::lock_guard lock(finish_mutex);
       if (finished) return;
-      source_stop.store(true);
-      lead_cv.notify_all();
-      {
-        std::lock_guard sources_lock(sources_mutex);
-        for (auto& s : sources) s.join();
-      }
+      stopSources();
       abort.store(true);
       for (auto* q : {&q_in, &q_map}) q->close();
       q_pose.close();
