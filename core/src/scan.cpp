@@ -14,6 +14,16 @@ void Scan::reserve(std::size_t n) {
   return_index.reserve(n);
 }
 
+void Scan::resize(std::size_t n) {
+  x.resize(n);
+  y.resize(n);
+  z.resize(n);
+  intensity.resize(n);
+  ring.resize(n);
+  offset_ns.resize(n);
+  return_index.resize(n);
+}
+
 void Scan::clear() {
   x.clear();
   y.clear();

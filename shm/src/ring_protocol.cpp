@@ -54,13 +54,7 @@ bool copyOut(const RingView& ring, std::uint64_t index, Scan& out, ScanMeta* met
   detail::Checksum sum;
   sumHeader(sum, n, sequence, stamp, missing);
   // resize() stays within capacity once `out` has held a scan this large: no allocation in steady state.
-  out.x.resize(n);
-  out.y.resize(n);
-  out.z.resize(n);
-  out.intensity.resize(n);
-  out.offset_ns.resize(n);
-  out.ring.resize(n);
-  out.return_index.resize(n);
+  out.resize(n);
   std::byte* base = ring.slotBase(index);
   detail::copyFromShared(out.x.data(), base + g.x, 4u * n, sum);
   detail::copyFromShared(out.y.data(), base + g.y, 4u * n, sum);

@@ -46,13 +46,7 @@ void fillPattern(Scan& scan, std::uint64_t sequence, std::uint32_t points) {
   scan.sequence = sequence;
   scan.stamp_ns = 1'600'000'000'000'000'000 + static_cast<std::int64_t>(sequence) * 100'000'000;
   scan.missing_packets = static_cast<std::uint32_t>(sequence % 3);
-  scan.x.resize(points);
-  scan.y.resize(points);
-  scan.z.resize(points);
-  scan.intensity.resize(points);
-  scan.ring.resize(points);
-  scan.offset_ns.resize(points);
-  scan.return_index.resize(points);
+  scan.resize(points);
   for (std::uint32_t i = 0; i < points; ++i) {
     const Values v = valuesAt(sequence, i);
     scan.x[i] = v.x;

@@ -35,6 +35,8 @@ struct Scan {
   [[nodiscard]] TimeNs pointTime(std::size_t i) const { return stamp_ns + offset_ns[i]; }
 
   void reserve(std::size_t n);
+  /// Every array to n points (new points zeroed); within capacity it never allocates.
+  void resize(std::size_t n);
   void clear();
   /// Appends a point; `time_ns` must be ≥ stamp_ns (the assembler sets stamp_ns first).
   void push_back(const Point& p);
@@ -58,13 +60,7 @@ void Scan::filter(Pred keep) {
     return_index[out] = return_index[i];
     ++out;
   }
-  x.resize(out);
-  y.resize(out);
-  z.resize(out);
-  intensity.resize(out);
-  ring.resize(out);
-  offset_ns.resize(out);
-  return_index.resize(out);
+  resize(out);
 }
 
 }  // namespace rigcal
