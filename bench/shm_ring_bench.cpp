@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -29,6 +30,7 @@
 #include <vector>
 
 #include "rigcal/core/cpu_latency_request.hpp"
+#include "rigcal/drivers/pacing.hpp"
 #include "rigcal/shm/liveness.hpp"
 #include "rigcal/shm/ring_segment.hpp"
 #include "rigcal/shm/scan_ring_reader.hpp"
@@ -58,20 +60,8 @@ void pin(int cpu, int fifo_priority) {
   }
 }
 
-void sleepUntil(std::int64_t mono_ns) {
-  timespec ts{static_cast<time_t>(mono_ns / 1'000'000'000), static_cast<long>(mono_ns % 1'000'000'000)};
-  while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
-  }
-}
-
 void fill(Scan& s, std::uint32_t points) {
-  s.x.resize(points);
-  s.y.resize(points);
-  s.z.resize(points);
-  s.intensity.resize(points);
-  s.ring.resize(points);
-  s.offset_ns.resize(points);
-  s.return_index.resize(points);
+  s.resize(points);
   for (std::uint32_t i = 0; i < points; ++i) {
     s.x[i] = static_cast<float>(i) * 0.01f;
     s.y[i] = -static_cast<float>(i) * 0.02f;
@@ -117,9 +107,10 @@ int runWriter(const Args& a) {
   for (int i = 0; i < 5000 && readerNext(writer) < 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   const RingHeader& h = writer.view().header();
   std::int64_t in_publish = 0;
-  const std::int64_t t0 = monotonicNs();
+  const std::atomic<bool> never_stop{false};
+  const std::int64_t t0 = monotonicNs();  // the same CLOCK_MONOTONIC as drivers::sleepUntil
   for (long long k = 0; k < scans; ++k) {
-    if (period_ns > 0) sleepUntil(t0 + k * period_ns);
+    if (period_ns > 0) drivers::sleepUntil(t0 + k * period_ns, never_stop);
     // Throughput run: never overwrite a scan the reader has not read, so every byte counted is delivered.
     for (long long r; lockstep && (r = readerNext(writer)) >= 0 &&
                       static_cast<long long>(h.write_index.load()) - r >= o.slot_count - 1;) {
