@@ -21,6 +21,14 @@ constexpr std::size_t kQtTailBytes = 26;
 constexpr std::size_t kQtSafetyBytes = 17;
 constexpr std::size_t kQtSignatureBytes = 32;
 
+// Where the common fields sit in each protocol's tail (XT: protocol 6.1, QT128: 3.2): the fields are
+// the same, the QT tail carries two more bytes (mode flag, reserved) before them.
+struct TailLayout {
+  std::size_t return_mode, motor_rpm, date, timestamp_us;
+};
+constexpr TailLayout kXtTail{10, 11, 13, 19};
+constexpr TailLayout kQtTail{12, 13, 15, 21};
+
 // QT128C2X firing sequences (Hesai QT128C2X user manual, Appendix "Absolute Time of Point Cloud
 // Data", firetime table): offset of each channel (index = channel − 1) in ns from the start of its
 // block; 0 = the channel does not fire in that sequence. 96 channels fire per sequence, in 32
@@ -92,6 +100,13 @@ std::int64_t daysFromCivil(std::int64_t y, unsigned m, unsigned d) {
   const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
   const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
   return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
+}
+
+void readTail(const std::uint8_t* tail, const TailLayout& at, PacketView& v) {
+  v.return_mode = tail[at.return_mode];
+  v.motor_rpm = u16(tail + at.motor_rpm);
+  std::copy_n(tail + at.date, 6, v.date.begin());
+  v.timestamp_us = u32(tail + at.timestamp_us);
 }
 
 }  // namespace
@@ -260,10 +275,7 @@ std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> pay
     if (size != expected)
       return fail(spec, "size " + std::to_string(size) + ", expected " + std::to_string(expected));
     tail = p + body_end;
-    v.return_mode = tail[10];
-    v.motor_rpm = u16(tail + 11);
-    std::copy_n(tail + 13, 6, v.date.begin());
-    v.timestamp_us = u32(tail + 19);
+    readTail(tail, kXtTail, v);
     v.udp_sequence = u32(tail + kXtTailBytes);
     v.mode_flag = 0;
     v.has_crc = false;
@@ -281,10 +293,7 @@ std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> pay
                             " for flags " + hex(flags, 2));
     tail = p + tail_at;
     v.mode_flag = tail[5];
-    v.return_mode = tail[12];
-    v.motor_rpm = u16(tail + 13);
-    std::copy_n(tail + 15, 6, v.date.begin());
-    v.timestamp_us = u32(tail + 21);
+    readTail(tail, kQtTail, v);
     const std::size_t tail_end = kQtTailBytes + (has_sequence ? 4 : 0);
     v.udp_sequence.reset();
     if (has_sequence) v.udp_sequence = u32(tail + kQtTailBytes);
