@@ -4,6 +4,8 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
@@ -104,6 +106,35 @@ TEST_F(DriverCommand, KilledDriverIsReportedDeadAndARestartTakesOverItsRing) {
   EXPECT_NE(result.out.find("took over a stale ring"), std::string::npos) << result.out;
   EXPECT_GT(r.epoch(), first_epoch);
   EXPECT_EQ(scans_after_restart, offline(pcap).size());
+}
+
+// --low-latency needs the right to open /dev/cpu_dma_latency (root). Without it the driver says so in one
+// line and runs as it would without the option; with it, no warning. Run once as root (when the test is)
+// and once as an unprivileged user (setpriv to nobody), so both paths are exercised on any machine.
+TEST_F(DriverCommand, LowLatencyWithoutTheRightWarnsOnceAndStillPublishes) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  namespace fs = std::filesystem;
+  fs::permissions(dir_.path(), fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                                   fs::perms::others_read | fs::perms::others_exec);
+  std::vector<std::string> args = driverArgs(pcap, "max");
+  args.push_back("--low-latency");
+  const std::string warning = "warning: --low-latency not in effect: /dev/cpu_dma_latency: ";
+
+  std::vector<std::string> unprivileged;
+  if (::geteuid() == 0) {
+    if (std::system("setpriv --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "setpriv is needed to drop root";
+    unprivileged = {"setpriv", "--reuid=65534", "--regid=65534", "--clear-groups"};
+    const CommandResult root = RigcalProcess(args).wait();
+    ASSERT_EQ(root.exit_code, 0) << root.err;
+    EXPECT_EQ(root.err.find("--low-latency"), std::string::npos) << "root holds the limit: " << root.err;
+  }
+  const CommandResult user = RigcalProcess(args, unprivileged).wait();
+  ASSERT_EQ(user.exit_code, 0) << user.err;
+  const std::size_t at = user.err.find(warning);
+  ASSERT_NE(at, std::string::npos) << user.err;
+  EXPECT_EQ(user.err.find(warning, at + 1), std::string::npos) << "warned once";
+  EXPECT_NE(user.err.find("Permission denied", at), std::string::npos) << user.err;
+  EXPECT_NE(user.out.find(std::to_string(offline(pcap).size()) + " scans published"), std::string::npos) << user.out;
 }
 
 TEST_F(DriverCommand, BadSensorAndMissingInputAreClearErrors) {

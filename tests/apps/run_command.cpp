@@ -25,9 +25,11 @@ std::string slurp(const std::filesystem::path& p) {
 }
 }  // namespace
 
-RigcalProcess::RigcalProcess(const std::vector<std::string>& args) : dir_(std::make_unique<TempDir>()) {
-  const std::string bin = rigcalBinary().string();
-  std::vector<std::string> argv_storage{bin};
+RigcalProcess::RigcalProcess(const std::vector<std::string>& args, const std::vector<std::string>& launcher)
+    : dir_(std::make_unique<TempDir>()) {
+  std::vector<std::string> argv_storage = launcher;
+  argv_storage.push_back(rigcalBinary().string());
+  const std::string bin = argv_storage.front();
   argv_storage.insert(argv_storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : argv_storage) argv.push_back(a.data());
@@ -37,7 +39,7 @@ RigcalProcess::RigcalProcess(const std::vector<std::string>& args) : dir_(std::m
   posix_spawn_file_actions_addopen(&actions, 1, (*dir_ / "out").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_addopen(&actions, 2, (*dir_ / "err").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, bin.c_str(), &actions, nullptr, argv.data(), environ);
+  const int rc = posix_spawnp(&pid, bin.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) throw std::runtime_error("cannot start " + bin);
   pid_ = pid;

@@ -20,7 +20,8 @@ CommandResult runRigcal(const std::vector<std::string>& args);
 /// `rigcal args...` started in the background (stdout/stderr to files in a temp dir).
 class RigcalProcess {
  public:
-  explicit RigcalProcess(const std::vector<std::string>& args);
+  /// `launcher` (e.g. {"setpriv", "--reuid=65534", ...}) is run with the binary and args appended.
+  explicit RigcalProcess(const std::vector<std::string>& args, const std::vector<std::string>& launcher = {});
   ~RigcalProcess();  // kills the process if still running
   RigcalProcess(const RigcalProcess&) = delete;
   RigcalProcess& operator=(const RigcalProcess&) = delete;
