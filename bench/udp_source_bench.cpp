@@ -20,6 +20,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "bench_support.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
 #include "rigcal/drivers/udp_source.hpp"
 
@@ -133,16 +134,11 @@ void BM_recvfrom_single(benchmark::State& state) {
   setRate(state, size);
 }
 
-std::filesystem::path dataDir() {
-  if (const char* env = std::getenv("RIGCAL_DATA_DIR"); env && *env) return env;
-  return RIGCAL_DEFAULT_DATA_DIR;
-}
-
 const char* const kCaptures[] = {"velodyne/vls128_strongest.pcap", "ouster/OS-2-128-U1_v2.3.0_1024x10.pcap",
                                  "hesai/xt32_dual.pcap"};
 
 void BM_PcapSource_read(benchmark::State& state) {
-  const auto file = dataDir() / kCaptures[state.range(0)];
+  const auto file = rigcal::bench::dataDir() / kCaptures[state.range(0)];
   if (!std::filesystem::exists(file)) {
     state.SkipWithError(("capture not found (set RIGCAL_DATA_DIR): " + file.string()).c_str());
     return;
@@ -161,24 +157,15 @@ void BM_PcapSource_read(benchmark::State& state) {
   state.SetBytesProcessed(bytes);
 }
 
-double p99(const std::vector<double>& v) {
-  if (v.empty()) return 0;
-  std::vector<double> s(v);
-  std::sort(s.begin(), s.end());
-  // Nearest rank: with 10 repetitions this is the slowest one.
-  const auto rank = std::size_t(std::ceil(0.99 * double(s.size())));
-  return s[std::max<std::size_t>(rank, 1) - 1];
-}
-
 BENCHMARK(BM_UdpSource_recvmmsg)
     ->ArgNames({"bytes", "batch"})
     ->Args({1206, 64})
     ->Args({8192, 64})
     ->Args({1206, 1})
     ->Args({8192, 1})
-    ->ComputeStatistics("p99", p99);
-BENCHMARK(BM_recvfrom_single)->ArgName("bytes")->Arg(1206)->Arg(8192)->ComputeStatistics("p99", p99);
-BENCHMARK(BM_PcapSource_read)->ArgName("capture")->DenseRange(0, 2)->ComputeStatistics("p99", p99)->Unit(benchmark::kMillisecond);
+    ->ComputeStatistics("p99", rigcal::bench::p99);
+BENCHMARK(BM_recvfrom_single)->ArgName("bytes")->Arg(1206)->Arg(8192)->ComputeStatistics("p99", rigcal::bench::p99);
+BENCHMARK(BM_PcapSource_read)->ArgName("capture")->DenseRange(0, 2)->ComputeStatistics("p99", rigcal::bench::p99)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
