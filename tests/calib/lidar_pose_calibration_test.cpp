@@ -11,11 +11,7 @@
 namespace rigcal::calib {
 namespace {
 
-#if RIGCAL_SANITIZED
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
+using test::kSanitized;
 
 struct Errors {
   double translation_m, rotation_deg, time_ms;

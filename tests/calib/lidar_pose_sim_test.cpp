@@ -18,11 +18,7 @@
 namespace rigcal::calib {
 namespace {
 
-#if RIGCAL_SANITIZED
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
+using test::kSanitized;
 
 // Collects the decoded-equivalent sweeps of one sensor (sensor frame, sensor clock).
 class ScanCollector : public sim::SimulationSink {

@@ -23,3 +23,8 @@
 #ifndef RIGCAL_TSAN
 #define RIGCAL_TSAN 0
 #endif
+
+namespace rigcal::test {
+/// RIGCAL_SANITIZED as a constant for `if constexpr` / ternaries that size a test's workload.
+inline constexpr bool kSanitized = RIGCAL_SANITIZED != 0;
+}  // namespace rigcal::test
