@@ -9,16 +9,17 @@
 #include "rigcal/shm/liveness.hpp"
 #include "rigcal/shm/ring_error.hpp"
 #include "rigcal/shm/ring_segment.hpp"
+#include "memory_orders.hpp"
 #include "shared_copy.hpp"
 
 namespace rigcal::shm {
 
 namespace {
 
-constexpr auto kRelaxed = std::memory_order_relaxed;
-constexpr auto kAcquire = std::memory_order_acquire;
-constexpr auto kRelease = std::memory_order_release;
-constexpr auto kSeqCst = std::memory_order_seq_cst;
+using detail::kAcquire;
+using detail::kRelaxed;
+using detail::kRelease;
+using detail::kSeqCst;
 
 std::string hex(std::uint64_t v) {
   std::ostringstream s;
