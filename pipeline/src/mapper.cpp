@@ -7,6 +7,9 @@
 #include <future>
 #include <stdexcept>
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include "rigcal/pipeline/deskew.hpp"
 #include "rigcal/registration/covariance.hpp"
 #include "rigcal/registration/gicp.hpp"
@@ -62,6 +65,8 @@ struct Mapper::Impl {
   // scan sequence: offline runs stay deterministic), waiting for it only if it is not ready by then.
   std::future<std::shared_ptr<const reg::Target>> pending_target;
   int scans_since_launch = 0;
+  bool rebuild_wanted = false;          // real time: a keyframe came while a build was still running
+  static constexpr int kBuildNiceness = 5;  // weight ~1/3 of the mapper's: slowed, never starved
   static constexpr int kSwapAfterScans = 2;
   // The last two good registrations (mid-sweep poses and times): the motion model.
   bool have_last = false, have_prev = false, last_failed = false;
@@ -99,6 +104,10 @@ struct Mapper::Impl {
 
   void swapInPendingTarget(bool now) {
     if (!pending_target.valid()) return;
+    if (!target) {  // a first or restarted map: nothing else to register against, wait for it
+      target = pending_target.get();
+      return;
+    }
     ++scans_since_launch;
     const bool ready = pending_target.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
     if (!now && (deterministic ? scans_since_launch < kSwapAfterScans : !ready)) return;
@@ -113,14 +122,32 @@ struct Mapper::Impl {
     all_keyframes.push_back(k);
     local.push_back(std::move(k));
     while (int(local.size()) > std::max(1, params.local_map_num_keyframes)) local.pop_front();
-    swapInPendingTarget(true);
-    std::vector<KeyframeCloud> clouds(local.begin(), local.end());
-    if (restart || !target) {  // the old map is no use: build it now
-      target = buildTarget(clouds, params, use_ndt);
+    // A first or restarted map is built in the background too: the scan that seeds it returns at once and
+    // the next one (a sweep period later) finds it ready, or waits for the rest. Either way every scan
+    // registers against the same map, whatever the timing: offline runs stay deterministic.
+    if (restart || !target) {
+      target.reset();
+      launchBuild();
       return;
     }
+    if (!deterministic && pending_target.valid() &&
+        pending_target.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      // Real time: never wait for the last build. It is swapped in when ready; this keyframe's map follows.
+      rebuild_wanted = true;
+      return;
+    }
+    swapInPendingTarget(true);
+    launchBuild();
+  }
+
+  void launchBuild() {
+    std::vector<KeyframeCloud> clouds(local.begin(), local.end());
     scans_since_launch = 0;
+    rebuild_wanted = false;
     pending_target = std::async(std::launch::async, [clouds = std::move(clouds), p = params, ndt = use_ndt] {
+      // Below the registering thread: a build (~5x one registration's CPU) must not stretch the scans
+      // that register meanwhile, on two cores. Its helper threads inherit the niceness.
+      ::setpriority(PRIO_PROCESS, id_t(::gettid()), kBuildNiceness);
       return buildTarget(clouds, p, ndt);
     });
   }
@@ -193,6 +220,7 @@ struct Mapper::Impl {
     out.registered = true;
 
     swapInPendingTarget(false);
+    if (rebuild_wanted && !pending_target.valid()) launchBuild();
     Pose pose = Pose::Identity();
     Scan deskewed = scan;
     if (!target) {  // the first frame defines the map
