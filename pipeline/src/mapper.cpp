@@ -1,10 +1,12 @@
 #include "rigcal/pipeline/mapper.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <chrono>
 #include <future>
+#include <sstream>
 #include <stdexcept>
 
 #include <sys/resource.h>
@@ -152,6 +154,25 @@ struct Mapper::Impl {
     });
   }
 
+  // A capture (or a driver started mid-rotation) begins with part of a sweep. Seeding the map with it
+  // leaves the next full sweeps half outside the map: they fail the fitness check and are lost until the
+  // map restarts. So the first seed must cover kCompleteSweep of the rotation: of the whole circle for the
+  // very first sweep, of the fullest sweep seen so far after that (a sensor with a limited field of view
+  // loses one sweep, never more).
+  static constexpr double kCompleteSweep = 0.9;
+  bool seed_checked = false;
+  double best_coverage = 0.0;
+
+  /// Fraction of the 360 one-degree azimuth sectors around the sensor that hold a point.
+  static double azimuthCoverage(const Scan& scan) {
+    std::array<bool, 360> hit{};
+    for (std::size_t i = 0; i < scan.size(); ++i) {
+      const double deg = std::atan2(double(scan.y[i]), double(scan.x[i])) * 180.0 / M_PI + 180.0;
+      hit[std::min<std::size_t>(359, std::size_t(deg))] = true;
+    }
+    return double(std::count(hit.begin(), hit.end(), true)) / 360.0;
+  }
+
   static constexpr double kCoarseCorrespondence = 1.0;  // m
   // A scan-to-map registration needs a few thousand well-spread points, not every voxel: beyond this the
   // voxelised scan is thinned with a fixed stride (deterministic), which keeps the mapper within a 10 Hz
@@ -216,6 +237,20 @@ struct Mapper::Impl {
       out.skipped_reason = std::to_string(scan.size()) + " points < min_mapping_pointcloud_size " +
                            std::to_string(params.min_mapping_pointcloud_size);
       return out;
+    }
+    if (!have_last) {  // this sweep would seed the map: it must be a whole rotation
+      const double coverage = azimuthCoverage(scan);
+      const double required = kCompleteSweep * (seed_checked ? best_coverage : 1.0);
+      best_coverage = std::max(best_coverage, coverage);
+      const bool first_look = !seed_checked;
+      seed_checked = true;
+      if (coverage < required) {
+        std::ostringstream why;
+        why << "incomplete sweep cannot seed the map: it covers " << std::lround(100 * coverage) << "% of the rotation"
+            << (first_look ? "" : " (the fullest so far " + std::to_string(std::lround(100 * best_coverage)) + "%)");
+        out.skipped_reason = why.str();
+        return out;
+      }
     }
     out.registered = true;
 

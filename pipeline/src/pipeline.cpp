@@ -68,6 +68,7 @@ PipelineProgress Pipeline::progress() const {
   PipelineProgress p;
   p.mapping_scans = m.mapping_scans.load();
   p.registered = m.registered.load();
+  p.skipped = m.skipped.load();
   p.stored_frames = m.stored.load();
   p.keyframes = m.keyframes.load();
   p.stopped_frames = m.stopped.load();

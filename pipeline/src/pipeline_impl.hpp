@@ -124,6 +124,7 @@ struct Pipeline::Impl {
       rec_selector{"selector"};
 
   // Progress.
+  std::atomic<std::uint64_t> skipped{0};
   std::atomic<std::uint64_t> mapping_scans{0}, registered{0}, stored{0}, keyframes{0}, stopped{0}, lost{0},
       unknown_sensor_scans{0};
   std::atomic<bool> mapping_done{false};

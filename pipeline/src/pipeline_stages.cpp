@@ -86,6 +86,7 @@ void Pipeline::Impl::mapperStage() {
     }
     item->scan.reset();
     if (!out.registered) {
+      skipped.fetch_add(1);
       mapping_done.store(mapper.done());
       continue;
     }
