@@ -122,7 +122,7 @@ TEST(PacketRestamper, ForeignPacketsAndUnknownModelsAreLeftAlone) {
   EXPECT_THROW(PacketRestamper{c}, std::runtime_error);  // no metadata: says so
   c.model = "LD-9000";
   try {
-    PacketRestamper{c};
+    const PacketRestamper unknown(c);
     ADD_FAILURE() << "an unknown model was accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("LD-9000"), std::string::npos) << e.what();

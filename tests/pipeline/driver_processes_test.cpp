@@ -78,9 +78,7 @@ struct MapProgress {
 /// "scans 812 | kf 41 stopped 0 lost 0 | front_left 2/2 (cand 30) done | ..." (the last such line).
 MapProgress parseProgress(const std::string& out) {
   MapProgress m;
-  std::smatch g;
   const std::regex head(R"(scans (\d+) \| kf (\d+) stopped \d+ lost (\d+))");
-  std::string last;
   for (auto it = std::sregex_iterator(out.begin(), out.end(), head); it != std::sregex_iterator(); ++it) {
     m.scans = std::stoull((*it)[1]);
     m.keyframes = std::stoull((*it)[2]);
@@ -111,6 +109,13 @@ TEST(PipelineProcesses, SimReplayedAt1xIntoDriverProcessesAndMapOverShmDropsNoth
   const int offset = 20000 + int(::getpid() % 20000);
   const fs::path rig = receiverRig(sim_dir, offset);
   const std::string prefix = "rigcal.proctest." + std::to_string(::getpid()) + ".";
+  struct RingSweeper {  // a failed run must not leave rings behind (killed drivers cannot unlink theirs)
+    std::string prefix;
+    ~RingSweeper() {
+      std::error_code ec;
+      for (const auto& s : kSensors) fs::remove("/dev/shm/" + prefix + s, ec);
+    }
+  } sweeper{prefix};
 
   // The pipeline first: its ring readers attach to each ring as it appears and read it from its oldest scan.
   RigcalProcess map({"map", "--config", rig.string(), "--shm", "--shm-prefix", prefix, "--cores", "0,1", "--out",
