@@ -120,6 +120,7 @@ void run(const SimArgs& a) {
   options.threads = a.threads;
   options.build_scans = bool(dumper);
   if (a.duration_s) options.max_duration_ns = fromSeconds(*a.duration_s);
+  if (a.duration_s) std::cout << "simulating the first " << *a.duration_s << " s only (--duration)\n";
   sim::SimulationStats st;
   if (missing.empty()) {
     const sim::RecordingResult r = sim::writeRecording(s, std::move(encoders), pcap, options, dumper.get());
