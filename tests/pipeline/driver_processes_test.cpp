@@ -29,9 +29,9 @@ namespace {
 namespace fs = std::filesystem;
 using std::chrono::milliseconds;
 
-// Release: 9 s of driving (keyframes and pairings on both calibration lidars). Sanitizers: 3.5 s, which
+// Release: 7.5 s of driving (keyframes and pairings on both calibration lidars). Sanitizers: 3.5 s, which
 // the slower mapper still holds in its queue without a drop.
-constexpr double kSeconds = RIGCAL_SANITIZED ? 3.5 : 9.0;
+constexpr double kSeconds = RIGCAL_SANITIZED ? 3.5 : 7.5;
 const std::vector<std::string> kSensors = {"top", "front_left", "front_right"};
 
 std::string slurp(const fs::path& p) {
