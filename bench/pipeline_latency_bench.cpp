@@ -46,6 +46,12 @@ std::string loadavg() {
 
 double ms(std::int64_t ns) { return double(ns) * 1e-6; }
 
+std::int64_t processCpuNs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
 void printStage(const char* label, const pipeline::LatencyHistogram& h) {
   std::printf("  %-26s n=%5llu  p50 %8.2f ms  p99 %8.2f ms  max %8.2f ms\n", label,
               static_cast<unsigned long long>(h.count()), ms(h.quantile(0.5)), ms(h.quantile(0.99)), ms(h.max()));
@@ -106,13 +112,23 @@ int main(int argc, char** argv) {
   {
     pipeline::Mapper mapper(rig.parameters);
     pipeline::LatencyHistogram h;
+    std::vector<std::pair<std::int64_t, std::uint64_t>> slowest;  // (ns, scan sequence): where the tail is
     const auto cpu0 = std::clock();
     for (const auto& s : rec.scans) {
       if (s.sensor_id != rig.roles.mapping_lidar) continue;
       const auto t0 = std::chrono::steady_clock::now();
+      const std::int64_t c0 = processCpuNs();
       mapper.process(s);
-      h.record(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count());
+      const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
+      h.record(ns);
+      // CPU, not wall: on a loaded machine the wall tail is other processes' time slices.
+      slowest.emplace_back(processCpuNs() - c0, s.sequence);
     }
+    std::sort(slowest.rbegin(), slowest.rend());
+    std::printf("most CPU-hungry mapper scans, all threads (sequence: CPU ms):");
+    for (std::size_t i = 0; i < std::min<std::size_t>(6, slowest.size()); ++i)
+      std::printf(" %llu: %.1f", static_cast<unsigned long long>(slowest[i].second), ms(slowest[i].first));
+    std::printf("\n");
     std::printf("baseline (mapper alone, serial, compute only): %.1f ms CPU per scan\n",
                 1e3 * double(std::clock() - cpu0) / CLOCKS_PER_SEC / double(std::max<std::uint64_t>(1, h.count())));
     printStage("mapper process()", h);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <span>
 #include <stdexcept>
 
 #include "rigcal/drivers/pacing.hpp"
@@ -59,6 +60,8 @@ ReplayStats PcapReplayer::run() {
   ReplayStats stats;
   const bool paced = config_.rate > 0;
   std::optional<TimeNs> start_wall;      // monotonic time of the first send
+  TimeNs start_realtime = 0;              // the same instant on the wall clock (for rewrite)
+  std::vector<std::uint8_t> rewritten;
   TimeNs pass_offset_ns = 0;              // capture time already played in earlier passes (scaled)
   TimeNs last_deadline = 0;
   TimeNs last_send = 0;
@@ -83,7 +86,18 @@ ReplayStats PcapReplayer::run() {
       const int fd = socketFor(packet->source);
 
       TimeNs deadline = 0;
-      if (!start_wall) start_wall = monotonicNow();
+      if (!start_wall) {
+        start_wall = monotonicNow();
+        timespec now{};
+        ::clock_gettime(CLOCK_REALTIME, &now);
+        start_realtime = TimeNs(now.tv_sec) * kNsPerSec + now.tv_nsec;
+      }
+      std::span<const std::uint8_t> payload = packet->payload;
+      if (config_.rewrite) {
+        rewritten.assign(payload.begin(), payload.end());
+        config_.rewrite(*packet, rewritten, start_realtime + pass_offset_ns - *pass_first);
+        payload = rewritten;
+      }
       if (paced) {
         const TimeNs recorded = packet->receive_ns - *pass_first;
         deadline = *start_wall + pass_offset_ns + TimeNs(double(recorded) / config_.rate);
@@ -100,14 +114,14 @@ ReplayStats PcapReplayer::run() {
       target.sin_port = htons(std::uint16_t(port));
       ssize_t rc;
       do {
-        rc = ::sendto(fd, packet->payload.data(), packet->payload.size(), 0,
+        rc = ::sendto(fd, payload.data(), payload.size(), 0,
                       reinterpret_cast<const sockaddr*>(&target), sizeof target);
       } while (rc < 0 && errno == EINTR && !stop_.load(std::memory_order_relaxed));
       if (rc < 0) {
         ++stats.send_errors;
       } else {
         ++stats.packets;
-        stats.bytes += packet->payload.size();
+        stats.bytes += payload.size();
       }
       last_send = monotonicNow();
       ++pass_packets;

@@ -1,11 +1,16 @@
 #include "rigcal/pipeline/mapper.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <chrono>
 #include <future>
+#include <sstream>
 #include <stdexcept>
+
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include "rigcal/pipeline/deskew.hpp"
 #include "rigcal/registration/covariance.hpp"
@@ -62,6 +67,8 @@ struct Mapper::Impl {
   // scan sequence: offline runs stay deterministic), waiting for it only if it is not ready by then.
   std::future<std::shared_ptr<const reg::Target>> pending_target;
   int scans_since_launch = 0;
+  bool rebuild_wanted = false;          // real time: a keyframe came while a build was still running
+  static constexpr int kBuildNiceness = 5;  // weight ~1/3 of the mapper's: slowed, never starved
   static constexpr int kSwapAfterScans = 2;
   // The last two good registrations (mid-sweep poses and times): the motion model.
   bool have_last = false, have_prev = false, last_failed = false;
@@ -99,6 +106,10 @@ struct Mapper::Impl {
 
   void swapInPendingTarget(bool now) {
     if (!pending_target.valid()) return;
+    if (!target) {  // a first or restarted map: nothing else to register against, wait for it
+      target = pending_target.get();
+      return;
+    }
     ++scans_since_launch;
     const bool ready = pending_target.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
     if (!now && (deterministic ? scans_since_launch < kSwapAfterScans : !ready)) return;
@@ -113,16 +124,53 @@ struct Mapper::Impl {
     all_keyframes.push_back(k);
     local.push_back(std::move(k));
     while (int(local.size()) > std::max(1, params.local_map_num_keyframes)) local.pop_front();
-    swapInPendingTarget(true);
-    std::vector<KeyframeCloud> clouds(local.begin(), local.end());
-    if (restart || !target) {  // the old map is no use: build it now
-      target = buildTarget(clouds, params, use_ndt);
+    // A first or restarted map is built in the background too: the scan that seeds it returns at once and
+    // the next one (a sweep period later) finds it ready, or waits for the rest. Either way every scan
+    // registers against the same map, whatever the timing: offline runs stay deterministic.
+    if (restart || !target) {
+      target.reset();
+      launchBuild();
       return;
     }
+    if (!deterministic && pending_target.valid() &&
+        pending_target.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      // Real time: never wait for the last build. It is swapped in when ready; this keyframe's map follows.
+      rebuild_wanted = true;
+      return;
+    }
+    swapInPendingTarget(true);
+    launchBuild();
+  }
+
+  void launchBuild() {
+    std::vector<KeyframeCloud> clouds(local.begin(), local.end());
     scans_since_launch = 0;
+    rebuild_wanted = false;
     pending_target = std::async(std::launch::async, [clouds = std::move(clouds), p = params, ndt = use_ndt] {
+      // Below the registering thread: a build (~5x one registration's CPU) must not stretch the scans
+      // that register meanwhile, on two cores. Its helper threads inherit the niceness.
+      ::setpriority(PRIO_PROCESS, id_t(::gettid()), kBuildNiceness);
       return buildTarget(clouds, p, ndt);
     });
+  }
+
+  // A capture (or a driver started mid-rotation) begins with part of a sweep. Seeding the map with it
+  // leaves the next full sweeps half outside the map: they fail the fitness check and are lost until the
+  // map restarts. So the first seed must cover kCompleteSweep of the rotation: of the whole circle for the
+  // very first sweep, of the fullest sweep seen so far after that (a sensor with a limited field of view
+  // loses one sweep, never more).
+  static constexpr double kCompleteSweep = 0.9;
+  bool seed_checked = false;
+  double best_coverage = 0.0;
+
+  /// Fraction of the 360 one-degree azimuth sectors around the sensor that hold a point.
+  static double azimuthCoverage(const Scan& scan) {
+    std::array<bool, 360> hit{};
+    for (std::size_t i = 0; i < scan.size(); ++i) {
+      const double deg = std::atan2(double(scan.y[i]), double(scan.x[i])) * 180.0 / M_PI + 180.0;
+      hit[std::min<std::size_t>(359, std::size_t(deg))] = true;
+    }
+    return double(std::count(hit.begin(), hit.end(), true)) / 360.0;
   }
 
   static constexpr double kCoarseCorrespondence = 1.0;  // m
@@ -190,9 +238,24 @@ struct Mapper::Impl {
                            std::to_string(params.min_mapping_pointcloud_size);
       return out;
     }
+    if (!have_last) {  // this sweep would seed the map: it must be a whole rotation
+      const double coverage = azimuthCoverage(scan);
+      const double required = kCompleteSweep * (seed_checked ? best_coverage : 1.0);
+      best_coverage = std::max(best_coverage, coverage);
+      const bool first_look = !seed_checked;
+      seed_checked = true;
+      if (coverage < required) {
+        std::ostringstream why;
+        why << "incomplete sweep cannot seed the map: it covers " << std::lround(100 * coverage) << "% of the rotation"
+            << (first_look ? "" : " (the fullest so far " + std::to_string(std::lround(100 * best_coverage)) + "%)");
+        out.skipped_reason = why.str();
+        return out;
+      }
+    }
     out.registered = true;
 
     swapInPendingTarget(false);
+    if (rebuild_wanted && !pending_target.valid()) launchBuild();
     Pose pose = Pose::Identity();
     Scan deskewed = scan;
     if (!target) {  // the first frame defines the map

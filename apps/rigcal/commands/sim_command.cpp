@@ -30,6 +30,7 @@ struct SimArgs {
   bool list = false;
   int threads = 2;
   std::optional<double> perturb_translation_m, perturb_rotation_deg;
+  std::optional<double> duration_s;  // simulate only the first seconds of the trajectory
 };
 
 // Writes every simulated sweep as a PCD file under DIR/scans/<sensor>/.
@@ -118,6 +119,8 @@ void run(const SimArgs& a) {
   sim::SimulationOptions options;
   options.threads = a.threads;
   options.build_scans = bool(dumper);
+  if (a.duration_s) options.max_duration_ns = fromSeconds(*a.duration_s);
+  if (a.duration_s) std::cout << "simulating the first " << *a.duration_s << " s only (--duration)\n";
   sim::SimulationStats st;
   if (missing.empty()) {
     const sim::RecordingResult r = sim::writeRecording(s, std::move(encoders), pcap, options, dumper.get());
@@ -152,6 +155,8 @@ void addSimCommand(CLI::App& app) {
                   "rig.yaml: initial extrinsics off the truth by this many degrees (default: the scenario's, 5)")
       ->check(CLI::Range(0.0, 90.0));
   cmd->add_flag("--dump-scans", a->dump_scans, "Also write every simulated sweep as PCD under DIR/scans/<sensor>/");
+  cmd->add_option("--duration", a->duration_s, "Simulate only the first S seconds of the scenario (default: all of it)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--list", a->list, "List the preset scenarios and exit");
   cmd->footer(kExitCodesHelp);
   cmd->callback([a] { run(*a); });

@@ -280,6 +280,8 @@ std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> pay
     v.mode_flag = 0;
     v.has_crc = false;
     v.crc_ok = true;
+    v.tail = tail;
+    v.tail_crc_bytes = 0;
   } else {
     if (flags & 0x02) return fail(spec, "flags " + hex(flags, 2) + " announce IMU fields (not supported)");
     if (flags & 0x40)
@@ -298,6 +300,8 @@ std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> pay
     v.udp_sequence.reset();
     if (has_sequence) v.udp_sequence = u32(tail + kQtTailBytes);
     v.has_crc = true;
+    v.tail = tail;
+    v.tail_crc_bytes = tail_end;
     bool ok = crc32Mpeg2({v.body, body_bytes}) == u32(p + body_end);
     if (has_safety) {
       const std::uint8_t* fs = p + body_end + 4;

@@ -6,8 +6,10 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <utility>
+#include <vector>
 
 #include "rigcal/core/time.hpp"
 #include "rigcal/drivers/packet_source.hpp"
@@ -22,6 +24,11 @@ struct ReplayConfig {
   bool allow_remote = false;       // permit targets outside 127.0.0.0/8
   PacketFilter filter;             // which datagrams of the capture to send
   TimeNs late_threshold_ns = kNsPerMs;  // a send later than its deadline by more than this is "late"
+  /// Optional: rewrites a copy of each datagram's payload before it is sent (restamping).
+  /// `capture_to_wall_ns` added to a capture time gives the wall-clock (CLOCK_REALTIME) time this pass
+  /// sends it at (exactly at rate 1; later passes of --loop continue where the last one ended).
+  std::function<void(const UdpPacket& packet, std::vector<std::uint8_t>& payload, TimeNs capture_to_wall_ns)>
+      rewrite;
 };
 
 struct ReplayStats {

@@ -63,6 +63,7 @@ struct LidarProgress {
 struct PipelineProgress {
   std::uint64_t mapping_scans = 0;  // mapping-lidar scans received
   std::uint64_t registered = 0;     // scans through the mapper
+  std::uint64_t skipped = 0;        // scans the mapper skipped: too few points, an incomplete seed sweep, map full
   std::uint64_t stored_frames = 0;
   std::uint64_t keyframes = 0;
   std::uint64_t stopped_frames = 0;

@@ -67,6 +67,8 @@ struct PacketView {
   std::optional<std::uint32_t> udp_sequence;
   bool has_crc = false;                 // protocol 3.2: CRC fields present
   bool crc_ok = true;                   // all present CRCs match
+  const std::uint8_t* tail = nullptr;   // the tail (date at +13 for protocol 6.1, +15 for 3.2)
+  std::size_t tail_crc_bytes = 0;       // protocol 3.2: tail bytes CRC3 covers (it follows them); else 0
 
   [[nodiscard]] std::size_t blockBytes() const { return 2u + 4u * channels; }
   [[nodiscard]] const std::uint8_t* block(int b) const { return body + b * blockBytes(); }

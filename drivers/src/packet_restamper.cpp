@@ -1,0 +1,135 @@
+#include "rigcal/drivers/packet_restamper.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <optional>
+#include <stdexcept>
+
+#include "rigcal/drivers/hesai/hesai_packet.hpp"
+#include "rigcal/drivers/ouster/ouster_decoder.hpp"
+#include "rigcal/drivers/ouster/ouster_metadata.hpp"
+#include "rigcal/drivers/ouster/ouster_packet_format.hpp"
+#include "rigcal/drivers/velodyne/velodyne_decoder.hpp"
+#include "rigcal/drivers/velodyne/velodyne_packet.hpp"
+
+namespace rigcal::drivers {
+
+namespace {
+
+template <class T>
+T load(const std::uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+template <class T>
+void store(std::uint8_t* p, T v) {
+  std::memcpy(p, &v, sizeof v);
+}
+
+std::int64_t floorMod(std::int64_t a, std::int64_t m) { return ((a % m) + m) % m; }
+
+// Proleptic Gregorian date of a day count since 1970-01-01 (the inverse of the era-based days-from-civil).
+void civilFromDays(std::int64_t z, std::int64_t& year, unsigned& month, unsigned& day) {
+  z += 719468;
+  const std::int64_t era = (z >= 0 ? z : z - 146096) / 146097;
+  const auto doe = unsigned(z - era * 146097);
+  const unsigned yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+  const unsigned doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+  const unsigned mp = (5 * doy + 2) / 153;
+  day = doy - (153 * mp + 2) / 5 + 1;
+  month = mp < 10 ? mp + 3 : mp - 9;
+  year = std::int64_t(yoe) + era * 400 + (month <= 2 ? 1 : 0);
+}
+
+enum class Vendor : std::uint8_t { kVelodyne, kOuster, kHesai };
+
+}  // namespace
+
+struct PacketRestamper::Impl {
+  Vendor vendor = Vendor::kVelodyne;
+  std::optional<ouster::PacketFormat> ouster_format;
+  bool ouster_crc = false;
+  const hesai::ModelSpec* hesai_spec = nullptr;
+
+  bool velodyne(std::span<std::uint8_t> p, std::int64_t shift_us) const {
+    if (p.size() != velodyne::kDataPacketSize) return false;
+    std::uint8_t* at = p.data() + velodyne::kTimestampOffset;
+    const std::uint32_t us = load<std::uint32_t>(at);
+    if (us >= velodyne::kMicrosPerHour) return false;
+    store(at, std::uint32_t(floorMod(std::int64_t(us) + shift_us, velodyne::kMicrosPerHour)));
+    return true;
+  }
+
+  bool ouster(std::span<std::uint8_t> p, std::int64_t shift_us) const {
+    const ouster::PacketFormat& f = *ouster_format;
+    if (p.size() != f.packet_size) return false;  // an IMU packet, or another sensor's
+    for (int c = 0; c < f.columns_per_packet; ++c) {
+      std::uint8_t* col = p.data() + f.packet_header_size + std::size_t(c) * f.column_size;
+      const auto ns = load<std::uint64_t>(col);
+      if (ns == 0) continue;  // a column the sensor did not fill (outside its window)
+      store(col, std::uint64_t(std::int64_t(ns) + shift_us * 1000));
+    }
+    if (ouster_crc) store(p.data() + p.size() - 8, ouster::crc64(p.data(), p.size() - 8));
+    return true;
+  }
+
+  bool hesai(std::span<std::uint8_t> p, std::int64_t shift_us) const {
+    hesai::PacketView v;
+    if (!hesai::parsePacket(*hesai_spec, p, v).empty()) return false;
+    const auto seconds = hesai::utcSeconds(v.date);
+    if (!seconds) return false;
+    const std::int64_t t_us = *seconds * 1'000'000 + std::int64_t(v.timestamp_us) + shift_us;
+    const std::int64_t s = t_us >= 0 ? t_us / 1'000'000 : (t_us - 999'999) / 1'000'000;
+    const std::int64_t days = s >= 0 ? s / 86400 : (s - 86399) / 86400;
+    const std::int64_t in_day = s - days * 86400;
+    std::int64_t year = 0;
+    unsigned month = 0, day = 0;
+    civilFromDays(days, year, month, day);
+    if (year < 1900 || year > 1900 + 255) return false;
+    auto* tail = p.data() + (v.tail - p.data());  // the same bytes, writable
+    const std::size_t date_at = hesai_spec->protocol_major == 6 ? 13 : 15;
+    const std::uint8_t date[6] = {std::uint8_t(year - 1900), std::uint8_t(month), std::uint8_t(day),
+                                  std::uint8_t(in_day / 3600), std::uint8_t(in_day / 60 % 60), std::uint8_t(in_day % 60)};
+    std::memcpy(tail + date_at, date, 6);
+    store(tail + date_at + 6, std::uint32_t(t_us - s * 1'000'000));
+    if (v.tail_crc_bytes > 0)
+      store(tail + v.tail_crc_bytes, hesai::crc32Mpeg2({tail, v.tail_crc_bytes}));
+    return true;
+  }
+};
+
+PacketRestamper::PacketRestamper(const DecoderConfig& sensor) : impl_(std::make_unique<Impl>()) {
+  const auto velodyne_models = velodyneModels();
+  if (std::find(velodyne_models.begin(), velodyne_models.end(), sensor.model) != velodyne_models.end()) {
+    impl_->vendor = Vendor::kVelodyne;
+  } else if (const hesai::ModelSpec* spec = hesai::findModel(sensor.model)) {
+    impl_->vendor = Vendor::kHesai;
+    impl_->hesai_spec = spec;
+  } else if (const auto ouster_models = ousterModels();
+             std::find(ouster_models.begin(), ouster_models.end(), sensor.model) != ouster_models.end()) {
+    if (sensor.metadata.empty())
+      throw std::runtime_error("Ouster " + sensor.model + ": restamping needs its metadata (sensor_info JSON)");
+    const ouster::Metadata md = ouster::parseMetadataFile(sensor.metadata);
+    impl_->vendor = Vendor::kOuster;
+    impl_->ouster_format.emplace(md.profile, md.pixels_per_column, md.columns_per_packet);
+    impl_->ouster_crc = md.crcFooter();
+  } else {
+    throw std::runtime_error("cannot restamp packets of lidar model '" + sensor.model + "'");
+  }
+}
+
+PacketRestamper::~PacketRestamper() = default;
+PacketRestamper::PacketRestamper(PacketRestamper&&) noexcept = default;
+PacketRestamper& PacketRestamper::operator=(PacketRestamper&&) noexcept = default;
+
+bool PacketRestamper::restamp(std::span<std::uint8_t> payload, std::int64_t shift_us) const {
+  switch (impl_->vendor) {
+    case Vendor::kVelodyne: return impl_->velodyne(payload, shift_us);
+    case Vendor::kOuster: return impl_->ouster(payload, shift_us);
+    case Vendor::kHesai: return impl_->hesai(payload, shift_us);
+  }
+  return false;
+}
+
+}  // namespace rigcal::drivers

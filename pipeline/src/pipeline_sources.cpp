@@ -1,0 +1,111 @@
+// The pipeline's input side: ingest (one entry point for push(), driver threads and ring readers), the
+// driver threads (pcap / live UDP through SensorDriver) and the shared-memory ring readers.
+#include "pipeline_impl.hpp"
+
+namespace rigcal::pipeline {
+
+void Pipeline::Impl::ingest(Scan&& scan, int sensor, std::int64_t t0_ns) {
+  if (sensor < 0) {
+    unknown_sensor_scans.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  if (sensor == 0) mapping_scans.fetch_add(1, std::memory_order_relaxed);
+  else lanes[std::size_t(sensor - 1)]->scans.fetch_add(1, std::memory_order_relaxed);
+  ScanItem item{std::make_shared<Scan>(std::move(scan)), sensor, t0_ns, false};
+  if (realtime) q_in.pushDropOldest(std::move(item));
+  else if (!q_in.push(std::move(item))) return;
+  rec_ingest.record(t0_ns);
+  wake_deskew.signal();
+}
+
+void Pipeline::Impl::endOfInput() {
+  q_in.push(ScanItem{nullptr, -1, steadyNs(), true});
+  wake_deskew.signal();
+}
+
+void Pipeline::Impl::waitForMappingLead(TimeNs stamp) {
+  std::unique_lock lock(lead_mutex);
+  lead_cv.wait(lock, [&] {
+    return mapping_source_done || source_stop.load() || stamp <= mapping_ingested_stamp + kCalibrationLeadNs;
+  });
+}
+
+void Pipeline::Impl::mappingIngested(TimeNs stamp, bool done) {
+  {
+    std::lock_guard lock(lead_mutex);
+    if (done) mapping_source_done = true;
+    else mapping_ingested_stamp = std::max(mapping_ingested_stamp, stamp);
+  }
+  lead_cv.notify_all();
+}
+
+void Pipeline::Impl::setUpSources() {
+  if (options.input == InputKind::kPcap || options.input == InputKind::kLive) {
+    DriverInput in;
+    if (options.input == InputKind::kPcap) {
+      in.pcap = options.pcap;
+      in.rate = options.rate;
+    }
+    const bool throttle = options.input == InputKind::kPcap && !realtime;
+    for (std::size_t s = 0; s < sensors.size(); ++s) {
+      const int sensor = int(s);
+      drivers.push_back(std::make_unique<SensorDriver>(
+          rig.sensor(sensors[s]), in, source_stop, [this, sensor, throttle](Scan&& scan) {
+            const std::int64_t t0 = steadyNs();
+            if (throttle && sensor > 0) waitForMappingLead(scan.stamp_ns);
+            const TimeNs stamp = scan.stamp_ns;
+            ingest(std::move(scan), sensor, t0);
+            if (throttle && sensor == 0) mappingIngested(stamp, false);
+          }));
+      driver_sensor.push_back(sensor);
+    }
+  } else if (options.input == InputKind::kShm) {
+    for (const auto& name : sensors) {
+      shm::ReaderOptions ro;
+      ro.sensor = name;
+      ro.name_prefix = options.shm_prefix;
+      ro.start_at = realtime ? shm::ReaderOptions::StartAt::kNext : shm::ReaderOptions::StartAt::kOldest;
+      readers.push_back(std::make_unique<shm::ScanRingReader>(ro));
+    }
+  }
+}
+
+void Pipeline::Impl::startSources() {
+  std::lock_guard lock(sources_mutex);
+  for (std::size_t d = 0; d < drivers.size(); ++d) {
+    ++sources_running;
+    sources.emplace_back("drv:" + sensors[std::size_t(driver_sensor[d])], options.cores, [this, d] {
+      drivers[d]->run();
+      if (driver_sensor[d] == 0) mappingIngested(0, true);
+      --sources_running;
+    });
+  }
+  for (std::size_t r = 0; r < readers.size(); ++r) {
+    ++sources_running;
+    sources.emplace_back("shm:" + sensors[r], options.cores, [this, r] {
+      Scan scan;
+      shm::ScanMeta meta;
+      bool got_any = false;
+      while (!source_stop.load()) {
+        const auto st = readers[r]->read(scan, std::chrono::milliseconds(100), &meta);
+        if (st == shm::ReadStatus::kScan) {
+          got_any = true;
+          ingest(Scan(scan), int(r), meta.publish_ns);
+        } else if (st == shm::ReadStatus::kWriterGone && got_any) {
+          break;
+        }
+      }
+      --sources_running;
+    });
+  }
+}
+
+// Stops the driver threads / ring readers and waits for them (caller holds finish_mutex).
+void Pipeline::Impl::stopSources() {
+  source_stop.store(true);
+  lead_cv.notify_all();
+  std::lock_guard sources_lock(sources_mutex);
+  for (auto& s : sources) s.join();
+}
+
+}  // namespace rigcal::pipeline
