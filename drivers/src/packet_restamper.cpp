@@ -88,7 +88,7 @@ struct PacketRestamper::Impl {
     civilFromDays(days, year, month, day);
     if (year < 1900 || year > 1900 + 255) return false;
     auto* tail = p.data() + (v.tail - p.data());  // the same bytes, writable
-    const std::size_t date_at = hesai_spec->protocol_major == 6 ? 13 : 15;
+    const std::size_t date_at = hesai::tailDateOffset(*hesai_spec);
     const std::uint8_t date[6] = {std::uint8_t(year - 1900), std::uint8_t(month), std::uint8_t(day),
                                   std::uint8_t(in_day / 3600), std::uint8_t(in_day / 60 % 60), std::uint8_t(in_day % 60)};
     std::memcpy(tail + date_at, date, 6);

@@ -28,6 +28,7 @@ struct TailLayout {
 };
 constexpr TailLayout kXtTail{10, 11, 13, 19};
 constexpr TailLayout kQtTail{12, 13, 15, 21};
+static_assert(kXtTail.timestamp_us == kXtTail.date + 6 && kQtTail.timestamp_us == kQtTail.date + 6);
 
 // QT128C2X firing sequences (Hesai QT128C2X user manual, Appendix "Absolute Time of Point Cloud
 // Data", firetime table): offset of each channel (index = channel − 1) in ns from the start of its
@@ -211,6 +212,10 @@ std::optional<std::int64_t> utcSeconds(const std::array<std::uint8_t, 6>& d) {
     return std::nullopt;
   const std::int64_t days = daysFromCivil(1900 + std::int64_t(d[0]), month, day);
   return days * 86400 + hour * 3600 + minute * 60 + second;
+}
+
+std::size_t tailDateOffset(const ModelSpec& spec) {
+  return spec.protocol_major == 6 ? kXtTail.date : kQtTail.date;
 }
 
 std::int32_t qt128LoopOffsetNs(int loop, int channel) {

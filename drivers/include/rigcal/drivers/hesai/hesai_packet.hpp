@@ -67,7 +67,7 @@ struct PacketView {
   std::optional<std::uint32_t> udp_sequence;
   bool has_crc = false;                 // protocol 3.2: CRC fields present
   bool crc_ok = true;                   // all present CRCs match
-  const std::uint8_t* tail = nullptr;   // the tail (date at +13 for protocol 6.1, +15 for 3.2)
+  const std::uint8_t* tail = nullptr;   // the tail (date at tailDateOffset(): +13 for protocol 6.1, +15 for 3.2)
   std::size_t tail_crc_bytes = 0;       // protocol 3.2: tail bytes CRC3 covers (it follows them); else 0
 
   [[nodiscard]] std::size_t blockBytes() const { return 2u + 4u * channels; }
@@ -103,6 +103,9 @@ std::int32_t qt128LoopOffsetNs(int loop, int channel);
 /// Seconds since the UNIX epoch of the tail date (year − 1900, month, day, hour, minute, second),
 /// independent of the local time zone; nullopt when a field is out of range.
 std::optional<std::int64_t> utcSeconds(const std::array<std::uint8_t, 6>& date);
+
+/// Where the tail date (6 bytes) starts in the tail of `spec`'s packets; the µs timestamp follows it.
+std::size_t tailDateOffset(const ModelSpec& spec);
 
 /// CRC-32/MPEG-2 (poly 0x04C11DB7, init 0xFFFFFFFF, no reflection, no final xor).
 std::uint32_t crc32Mpeg2(std::span<const std::uint8_t> bytes);
