@@ -29,6 +29,13 @@ CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> p
     for (const auto& p : pairs) {
       for (const auto& c : p.source->covariances) source_cov_.push_back(Sym3::upperOf(c));
     }
+    source_axis_.resize(total);
+    for (std::size_t g = 0; g < total; ++g) {
+      if (!rankOneFromIdentity(source_cov_[g], &source_axis_[g])) {
+        source_axis_.clear();  // a general covariance somewhere: the general kernel for all
+        break;
+      }
+    }
   }
 }
 
@@ -139,7 +146,8 @@ LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, con
       addRow(row, e, sys.H, sys.b);
       sys.cost += e * e;
     } else if constexpr (K == Residual::kGicp) {
-      const Sym3 w = fusedInverse(R, source_cov_[g], Sym3::load(target.covarianceUpper().data() + 6 * std::size_t{j}));
+      const Sym3 t = Sym3::load(target.covarianceUpper().data() + 6 * std::size_t{j});
+      const Sym3 w = source_axis_.empty() ? fusedInverse(R, source_cov_[g], t) : fusedInverseRank1(R, source_axis_[g], t);
       weight_[g] = w;
       const Eigen::Vector3d u = w.times(r);
       addWeighted(w.full(), q, u, sys.H, sys.b);
