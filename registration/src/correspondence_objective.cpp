@@ -44,16 +44,20 @@ CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> p
 // min(second best, R_c − |q − c|) bounds the runner-up: enough for the margin.
 bool CorrespondenceObjective::graphSearch(const Target& target, std::uint32_t start, const Eigen::Vector4d& q,
                                           std::uint32_t* j, float* margin) const {
-  constexpr float kSlack = 1e-4F;  // float rounding in the graph's radii
+  // In the tree's float copy of the points (half the memory of the cloud's doubles: on a dense map the
+  // walk is memory-bound). Slack for float rounding: the graph's radii are float tree distances too, and
+  // coordinates far from the tree's centre round more coarsely.
+  const std::span<const Eigen::Vector4f> pts = target.tree().localPoints();
+  const Eigen::Vector4f ql = target.tree().toLocal(q);
+  const float slack = 1e-4F + 4e-7F * ql.cwiseAbs().maxCoeff();
   const NeighborGraph& graph = target.neighborGraph();
-  const std::vector<Eigen::Vector4d>& pts = target.cloud().points;
   std::uint32_t c = start;
   for (int hop = 0; hop < 3; ++hop) {
-    const double dc2 = (q - pts[c]).squaredNorm();
+    const float dc2 = (ql - pts[c]).squaredNorm();
     std::uint32_t best = c;
-    double best2 = dc2, second2 = std::numeric_limits<double>::infinity();
+    float best2 = dc2, second2 = std::numeric_limits<float>::infinity();
     for (const std::uint32_t k : graph.of(c)) {
-      const double d2 = (q - pts[k]).squaredNorm();
+      const float d2 = (ql - pts[k]).squaredNorm();
       if (d2 < best2) {
         second2 = best2;
         best2 = d2;
@@ -62,15 +66,15 @@ bool CorrespondenceObjective::graphSearch(const Target& target, std::uint32_t st
         second2 = d2;
       }
     }
-    const float limit = graph.radius[c] - static_cast<float>(std::sqrt(dc2)) - kSlack;
-    const float best_d = static_cast<float>(std::sqrt(best2));
+    const float limit = graph.radius[c] - std::sqrt(dc2) - slack;
+    const float best_d = std::sqrt(best2);
     if (best_d < limit) {
-      if (best2 > max_sq_) {
+      if (static_cast<double>(best2) > max_sq_) {
         *j = kNone;
         return true;
       }
       *j = best;
-      *margin = 0.5F * (std::min(static_cast<float>(std::sqrt(second2)), limit) - best_d) - kSlack;
+      *margin = 0.5F * (std::min(std::sqrt(second2), limit) - best_d) - slack;
       return true;
     }
     if (best == c) return false;
