@@ -42,6 +42,9 @@ CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> p
 // Every target point outside {c} ∪ N(c) is at least R_c from c, hence at least R_c − |q − c| from q. So
 // when the best candidate in {c} ∪ N(c) is closer than that, it is the exact nearest point, and
 // min(second best, R_c − |q − c|) bounds the runner-up: enough for the margin.
+// Hops of the walk before the tree decides (callgrind: 3 → 6 saves ~1.5 %, 12 no more).
+constexpr int kMaxHops = 6;
+
 bool CorrespondenceObjective::graphSearch(const Target& target, std::uint32_t start, const Eigen::Vector4d& q,
                                           std::uint32_t* j, float* margin) const {
   // In the tree's float copy of the points (half the memory of the cloud's doubles: on a dense map the
@@ -52,7 +55,7 @@ bool CorrespondenceObjective::graphSearch(const Target& target, std::uint32_t st
   const float slack = 1e-4F + 4e-7F * ql.cwiseAbs().maxCoeff();
   const NeighborGraph& graph = target.neighborGraph();
   std::uint32_t c = start;
-  for (int hop = 0; hop < 3; ++hop) {
+  for (int hop = 0; hop < kMaxHops; ++hop) {
     const float dc2 = (ql - pts[c]).squaredNorm();
     std::uint32_t best = c;
     float best2 = dc2, second2 = std::numeric_limits<float>::infinity();
@@ -150,7 +153,7 @@ LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, con
       addRow(row, e, sys.H, sys.b);
       sys.cost += e * e;
     } else if constexpr (K == Residual::kGicp) {
-      const Sym3 t = Sym3::load(target.covarianceUpper().data() + 6 * std::size_t{j});
+      const Sym3 t = Sym3::load(target.covarianceUpperFloat().data() + 6 * std::size_t{j});
       const Sym3 w = source_axis_.empty() ? fusedInverse(R, source_cov_[g], t) : fusedInverseRank1(R, source_axis_[g], t);
       weight_[g] = w;
       const Eigen::Vector3d u = w.times(r);

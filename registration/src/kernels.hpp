@@ -109,6 +109,7 @@ struct Sym3 {
   }
   /// From 6 consecutive doubles (Target::covarianceUpper()).
   static Sym3 load(const double* u) { return {u[0], u[1], u[2], u[3], u[4], u[5]}; }
+  static Sym3 load(const float* u) { return {u[0], u[1], u[2], u[3], u[4], u[5]}; }
   [[nodiscard]] Eigen::Vector3d times(const Eigen::Vector3d& v) const {
     return {xx * v.x() + xy * v.y() + xz * v.z(), xy * v.x() + yy * v.y() + yz * v.z(),
             xz * v.x() + yz * v.y() + zz * v.z()};
