@@ -14,6 +14,8 @@
 #include <pcl/registration/ndt.h>
 
 #include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +24,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <valgrind/callgrind.h>
 
 #include "rigcal/core/pcd_io.hpp"
 #include "rigcal/registration/covariance.hpp"
@@ -349,6 +352,45 @@ void printTable() {
   }
 }
 
+// `registration_bench --profile CASE [N]`: runs one case N times (default 5) with callgrind's
+// instrumentation on only around the alignments, so `valgrind --tool=callgrind --instr-atstart=no` counts
+// exactly their instructions (machine-independent, unlike times on this shared machine). CASE is
+// s2s-gicp-cov, s2s-gicp, s2m-gicp-cov, s2m-gicp or cov (source covariances alone).
+int profile(const std::string& which, int runs) {
+  const Scenario* s = which.rfind("s2m", 0) == 0 ? &g_data->map : &g_data->scan;
+  const bool with_cov = which == "cov" || which.find("-cov") != std::string::npos;
+  GicpParams params = common<GicpParams>(1);
+  params.max_correspondence_distance = 1.0;
+  RegistrationResult r;
+  std::vector<double> ms, cpu_ms;
+  const auto thread_cpu_ms = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+  };
+  for (int i = 0; i < runs; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = thread_cpu_ms();
+    CALLGRIND_START_INSTRUMENTATION;
+    if (with_cov) {
+      PointCloud src = g_data->source;
+      estimateCovariances(src);
+      if (which != "cov") r = alignGicp(*s->target, src, Pose::Identity(), params);
+    } else {
+      r = alignGicp(*s->target, g_data->source_cov, Pose::Identity(), params);
+    }
+    CALLGRIND_STOP_INSTRUMENTATION;
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    cpu_ms.push_back(thread_cpu_ms() - cpu_start);
+  }
+  std::sort(ms.begin(), ms.end());
+  std::sort(cpu_ms.begin(), cpu_ms.end());
+  const Pose e = g_data->truth.inverse() * r.T_target_source;
+  std::printf("%s: %d runs, median %.2f ms (CPU %.2f), min %.2f ms (CPU %.2f); %d iterations, error %.3f mm / %.5f deg\n",
+              which.c_str(), runs, ms[ms.size() / 2], cpu_ms[cpu_ms.size() / 2], ms[0], cpu_ms[0], r.iterations, e.translation().norm() * 1e3, rad2deg(rotationAngle(e)));
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -361,6 +403,10 @@ int main(int argc, char** argv) {
       std::printf("SKIPPED: shared data not found: %s (set RIGCAL_DATA_DIR)\n", f.c_str());
       return 0;
     }
+  }
+  if (argc >= 3 && std::string(argv[1]) == "--profile") {
+    load(scan, other);
+    return profile(argv[2], argc >= 4 ? std::atoi(argv[3]) : 5);
   }
   benchmark::Initialize(&argc, argv);
   load(scan, other);

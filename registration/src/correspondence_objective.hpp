@@ -51,6 +51,7 @@ class CorrespondenceObjective final : public Objective {
   std::vector<float> margin_;           // how far it may move from there keeping the match (m)
   std::vector<Sym3> weight_;            // GICP: (C_t + R·C_s·Rᵀ)⁻¹ at the last linearisation
   std::vector<Sym3> source_cov_;        // GICP: the sources' covariances, compact, concatenated
+  std::vector<Eigen::Vector3d> source_axis_;  // GICP: v with C_s = I − v·vᵀ, when every source has that form
 };
 
 }  // namespace rigcal::registration::detail

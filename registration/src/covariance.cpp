@@ -7,9 +7,57 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "cell_knn.hpp"
 #include "rigcal/registration/parallel.hpp"
 
 namespace rigcal::registration {
+
+namespace {
+
+// Normal and plane-regularised covariance of point i from its `found` nearest (the point itself among
+// them); false (isotropic, no normal) with fewer than 3.
+bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t found, double plane_epsilon) {
+  if (found < 3) {
+    cloud.covariances[i].topLeftCorner<3, 3>().setIdentity();
+    return false;
+  }
+  // One pass of sums relative to the point itself (offsets of a neighbourhood: exact enough in double
+  // even far from the origin), then cov = E[d·dᵀ] − E[d]·E[d]ᵀ.
+  const Eigen::Vector3d origin = cloud.points[i].head<3>();
+  double sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+  for (std::size_t j = 0; j < found; ++j) {
+    const Eigen::Vector3d d = cloud.points[nb[j].index].head<3>() - origin;
+    sx += d.x();
+    sy += d.y();
+    sz += d.z();
+    sxx += d.x() * d.x();
+    sxy += d.x() * d.y();
+    sxz += d.x() * d.z();
+    syy += d.y() * d.y();
+    syz += d.y() * d.z();
+    szz += d.z() * d.z();
+  }
+  const double inv = 1.0 / static_cast<double>(found);
+  const double mx = sx * inv, my = sy * inv, mz = sz * inv;
+  Eigen::Matrix3d cov;
+  cov(0, 0) = sxx * inv - mx * mx;
+  cov(0, 1) = cov(1, 0) = sxy * inv - mx * my;
+  cov(0, 2) = cov(2, 0) = sxz * inv - mx * mz;
+  cov(1, 1) = syy * inv - my * my;
+  cov(1, 2) = cov(2, 1) = syz * inv - my * mz;
+  cov(2, 2) = szz * inv - mz * mz;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
+  // U·diag(ε, 1, 1)·Uᵀ = I − (1 − ε)·n·nᵀ for orthonormal U: only the normal is needed.
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  cloud.covariances[i].topLeftCorner<3, 3>() =
+      Eigen::Matrix3d::Identity() - (1.0 - plane_epsilon) * (normal * normal.transpose());
+  if (normal.dot(cloud.points[i].head<3>()) > 0.0) normal = -normal;  // face the sensor at the origin
+  cloud.normals[i].head<3>() = normal;
+  return true;
+}
+
+}  // namespace
 
 CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const CovarianceOptions& options,
                                     NeighborGraph* graph, std::size_t graph_degree) {
@@ -48,30 +96,7 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
         }
         if (m == degree && next < all) graph->radius[i] = std::sqrt(nb[next].sq_distance);
       }
-      const std::size_t found = std::min(all, k);  // the covariance uses the k nearest only
-      if (found < 3) {
-        cloud.covariances[i].topLeftCorner<3, 3>().setIdentity();
-        ++local_isolated;
-        continue;
-      }
-      // Centred two-pass sums: exact enough in double even for points far from the origin.
-      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (std::size_t j = 0; j < found; ++j) mean += cloud.points[nb[j].index].head<3>();
-      mean /= static_cast<double>(found);
-      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-      for (std::size_t j = 0; j < found; ++j) {
-        const Eigen::Vector3d d = cloud.points[nb[j].index].head<3>() - mean;
-        cov.noalias() += d * d.transpose();
-      }
-      cov /= static_cast<double>(found);
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-      eig.computeDirect(cov);
-      // U·diag(ε, 1, 1)·Uᵀ = I − (1 − ε)·n·nᵀ for orthonormal U: only the normal is needed.
-      Eigen::Vector3d normal = eig.eigenvectors().col(0);
-      cloud.covariances[i].topLeftCorner<3, 3>() =
-          Eigen::Matrix3d::Identity() - (1.0 - options.plane_epsilon) * (normal * normal.transpose());
-      if (normal.dot(cloud.points[i].head<3>()) > 0.0) normal = -normal;  // face the sensor at the origin
-      cloud.normals[i].head<3>() = normal;
+      if (!fillShape(cloud, i, nb.data(), std::min(all, k), options.plane_epsilon)) ++local_isolated;
     }
     isolated.fetch_add(local_isolated, std::memory_order_relaxed);
   });
@@ -79,10 +104,40 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
 }
 
 CovarianceStats estimateCovariances(PointCloud& cloud, const CovarianceOptions& options) {
-  KdTreeOptions tree_options;
-  tree_options.num_threads = options.num_threads;
-  const KdTree tree(cloud.points, tree_options);
-  return estimateCovariances(cloud, tree, options);
+  // The all-k-NN on a cell grid (no tree to build, most queries a short distance loop); the tree
+  // answers only the points the grid cannot prove (sparse outskirts), or all when a grid does not suit.
+  const std::size_t n = cloud.size();
+  const std::size_t k = static_cast<std::size_t>(std::max(options.num_neighbors, 3));
+  detail::CellKnn knn;
+  if (!detail::cellKnn(cloud.points, k, options.num_threads, &knn)) {
+    KdTreeOptions tree_options;
+    tree_options.num_threads = options.num_threads;
+    const KdTree tree(cloud.points, tree_options);
+    return estimateCovariances(cloud, tree, options);
+  }
+  if (!knn.unproven.empty()) {
+    KdTreeOptions tree_options;
+    tree_options.num_threads = options.num_threads;
+    const KdTree tree(cloud.points, tree_options);
+    const std::size_t m = knn.unproven.size();
+    parallelFor(chunkCount(m, kDefaultChunk), options.num_threads, [&](std::size_t task) {
+      for (std::size_t u = task * kDefaultChunk; u < std::min(m, (task + 1) * kDefaultChunk); ++u) {
+        const std::uint32_t i = knn.unproven[u];
+        knn.count[i] = static_cast<std::uint32_t>(tree.knn(cloud.points[i], k, knn.neighbors.data() + i * k));
+      }
+    });
+  }
+  cloud.normals.assign(n, Eigen::Vector4d::Zero());
+  cloud.covariances.assign(n, Eigen::Matrix4d::Zero());
+  std::atomic<std::size_t> isolated{0};
+  parallelFor(chunkCount(n, kDefaultChunk), options.num_threads, [&](std::size_t task) {
+    std::size_t local_isolated = 0;
+    for (std::size_t i = task * kDefaultChunk; i < std::min(n, (task + 1) * kDefaultChunk); ++i) {
+      if (!fillShape(cloud, i, knn.neighbors.data() + i * k, knn.count[i], options.plane_epsilon)) ++local_isolated;
+    }
+    isolated.fetch_add(local_isolated, std::memory_order_relaxed);
+  });
+  return {n, isolated.load()};
 }
 
 }  // namespace rigcal::registration

@@ -5,6 +5,9 @@
 // All methods perturb the pose on the left, in the target frame: T ← exp(δ)·T with δ = (ρ, ω). For a
 // transformed source point q = T·p that gives dq/dδ = J = [I, −[q]×]. Only the upper triangle of H is
 // accumulated; mirrorUpper() completes it once per chunk.
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Core>
 
 #include "rigcal/core/pose.hpp"
@@ -106,6 +109,7 @@ struct Sym3 {
   }
   /// From 6 consecutive doubles (Target::covarianceUpper()).
   static Sym3 load(const double* u) { return {u[0], u[1], u[2], u[3], u[4], u[5]}; }
+  static Sym3 load(const float* u) { return {u[0], u[1], u[2], u[3], u[4], u[5]}; }
   [[nodiscard]] Eigen::Vector3d times(const Eigen::Vector3d& v) const {
     return {xx * v.x() + xy * v.y() + xz * v.z(), xy * v.x() + yy * v.y() + yz * v.z(),
             xz * v.x() + yz * v.y() + zz * v.z()};
@@ -138,6 +142,44 @@ inline Sym3 fusedInverse(const Eigen::Matrix3d& R, const Sym3& s, const Sym3& t)
   const double c22 = f00 * f11 - f01 * f01;
   const double inv_det = 1.0 / (f00 * c00 + f01 * c01 + f02 * c02);
   return {c00 * inv_det, c01 * inv_det, c02 * inv_det, c11 * inv_det, c12 * inv_det, c22 * inv_det};
+}
+
+/// The same weight when the source covariance is I − v·vᵀ (how estimateCovariances builds them: plane-
+/// regularised, v = sqrt(1 − ε)·normal): R·C_s·Rᵀ = I − (R·v)(R·v)ᵀ, so rotating it costs one
+/// matrix-vector product instead of two 3x3 products.
+inline Sym3 fusedInverseRank1(const Eigen::Matrix3d& R, const Eigen::Vector3d& v, const Sym3& t) {
+  const Eigen::Vector3d u = R * v;
+  const double f00 = t.xx + 1.0 - u.x() * u.x(), f01 = t.xy - u.x() * u.y(), f02 = t.xz - u.x() * u.z();
+  const double f11 = t.yy + 1.0 - u.y() * u.y(), f12 = t.yz - u.y() * u.z(), f22 = t.zz + 1.0 - u.z() * u.z();
+  const double c00 = f11 * f22 - f12 * f12;
+  const double c01 = f02 * f12 - f01 * f22;
+  const double c02 = f01 * f12 - f02 * f11;
+  const double c11 = f00 * f22 - f02 * f02;
+  const double c12 = f01 * f02 - f00 * f12;
+  const double c22 = f00 * f11 - f01 * f01;
+  const double inv_det = 1.0 / (f00 * c00 + f01 * c01 + f02 * c02);
+  return {c00 * inv_det, c01 * inv_det, c02 * inv_det, c11 * inv_det, c12 * inv_det, c22 * inv_det};
+}
+
+/// v with C = I − v·vᵀ (v = 0 for C = I), if C has that form to rounding; false otherwise.
+inline bool rankOneFromIdentity(const Sym3& c, Eigen::Vector3d* v) {
+  const Sym3 m{1.0 - c.xx, -c.xy, -c.xz, 1.0 - c.yy, -c.yz, 1.0 - c.zz};
+  const double d[3] = {m.xx, m.yy, m.zz};
+  const int a = d[0] >= d[1] ? (d[0] >= d[2] ? 0 : 2) : (d[1] >= d[2] ? 1 : 2);
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+  if (d[a] > 0.0) {
+    const double s = 1.0 / std::sqrt(d[a]);
+    const Eigen::Vector3d col = a == 0 ? Eigen::Vector3d(m.xx, m.xy, m.xz)
+                                       : (a == 1 ? Eigen::Vector3d(m.xy, m.yy, m.yz) : Eigen::Vector3d(m.xz, m.yz, m.zz));
+    out = col * s;
+  }
+  constexpr double kTolerance = 1e-12;
+  const double err = std::max({std::abs(m.xx - out.x() * out.x()), std::abs(m.xy - out.x() * out.y()),
+                               std::abs(m.xz - out.x() * out.z()), std::abs(m.yy - out.y() * out.y()),
+                               std::abs(m.yz - out.y() * out.z()), std::abs(m.zz - out.z() * out.z())});
+  if (!(err <= kTolerance)) return false;
+  *v = out;
+  return true;
 }
 
 /// R·C·Rᵀ for symmetric C.

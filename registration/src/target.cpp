@@ -56,6 +56,7 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
     for (const Eigen::Matrix4d& c : cloud_.covariances) {
       covariance_upper_.insert(covariance_upper_.end(), {c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2)});
     }
+    covariance_upper_float_.assign(covariance_upper_.begin(), covariance_upper_.end());
   }
   for (const double resolution : options.ndt_resolutions) {
     if (ndtGrid(resolution) != nullptr) continue;

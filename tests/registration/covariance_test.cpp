@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <vector>
 
 #include "rigcal/registration/ndt_grid.hpp"
 #include "rigcal/registration/target.hpp"
@@ -46,6 +48,34 @@ TEST(Covariance, SameResultWithTwoThreads) {
   for (std::size_t i = 0; i < a.size(); ++i) {
     ASSERT_EQ(a.covariances[i], b.covariances[i]);
     ASSERT_EQ(a.normals[i], b.normals[i]);
+  }
+}
+
+// The tree-less estimateCovariances (k-NN on a cell grid, the tree only for what the grid cannot prove)
+// must give the tree's answer. Jittered so no two neighbours tie at the k-th distance (a tie may pick
+// either point); a far-away offset (UTM-like) and a few isolated points that the grid cannot vouch for
+// exercise the precision and the tree fallback.
+TEST(Covariance, GridNeighbourhoodsEqualTheTrees) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.02, 0.02);
+  PointCloud base = test::room(0.12);
+  for (auto& p : base.points) p.head<3>() += Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+  const std::vector<Eigen::Vector3d> offsets{Eigen::Vector3d::Zero(), Eigen::Vector3d(512345.6, 5412345.7, 230.1)};
+  for (const Eigen::Vector3d& offset : offsets) {
+    PointCloud a = base;
+    for (auto& p : a.points) p.head<3>() += offset;
+    for (int i = 0; i < 20; ++i) a.add(offset.x() + 40.0 + 3.0 * i, offset.y() - 7.0 * i, offset.z() + 0.5 * i);
+    PointCloud b = a;
+    const CovarianceStats grid = estimateCovariances(a);
+    const CovarianceStats tree = estimateCovariances(b, KdTree(b.points));
+    EXPECT_EQ(grid.without_neighborhood, tree.without_neighborhood);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      // Same neighbour set → the same sums in the same order up to the order of the set: 1e-9 allows that.
+      differ += (a.covariances[i] - b.covariances[i]).cwiseAbs().maxCoeff() > 1e-9 ||
+                (a.normals[i] - b.normals[i]).cwiseAbs().maxCoeff() > 1e-9;
+    }
+    EXPECT_EQ(differ, 0u) << "of " << a.size() << " points, offset " << offset.transpose();
   }
 }
 

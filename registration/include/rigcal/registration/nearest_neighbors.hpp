@@ -61,6 +61,13 @@ class KdTree {
   /// takes as a hint) refer to that new order.
   void useLeafOrderIndices();
 
+  /// The tree's own copy of the points: float offsets (w = 0) from its centre, in leaf order, so entry i
+  /// is the point the tree reports as i once useLeafOrderIndices() has run (as in a Target). Half the
+  /// bytes of the double cloud: what a search that walks many points (the ICP matcher's graph) reads.
+  [[nodiscard]] std::span<const Eigen::Vector4f> localPoints() const { return points_; }
+  /// q in the frame of localPoints() (w = 0).
+  [[nodiscard]] Eigen::Vector4f toLocal(const Eigen::Vector4d& q) const { return local(q); }
+
   /// Up to k nearest points closer than sqrt(max_sq_distance), closest first; returns how many.
   /// `hints` (distinct indices, e.g. last iteration's k nearest) seed the search; they only speed it up.
   std::size_t knn(const Eigen::Vector4d& q, std::size_t k, Neighbor* out,
