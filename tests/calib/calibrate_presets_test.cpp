@@ -135,6 +135,7 @@ TEST(CalibratePresetsLong, StreetShort) {
                                      // The roof lidar sees the ground under the car only once the car has
                                      // moved off it: on 11 m of drive the footprint crop holds ~500 points.
                                      "    base_lidar_min_plane_points: 300\n"
+                                     "    calibration_deadline_s: 30\n"
                                      "    calibration_skip_keyframes: 1\n"
                                      "    dense_pointcloud_num_keyframes: 3\n"
                                      "    calibration_min_distance_between_frames: 1.5\n"
