@@ -27,6 +27,15 @@ std::vector<Eigen::Vector3d> mapCloud(const std::vector<pipeline::CalibrationDat
   return out;
 }
 
+std::vector<Eigen::Vector3d> outcomeMapCloud(const CalibrationOutcome& outcome, double leaf) {
+  if (outcome.map_cloud == nullptr) return mapCloud(outcome.datasets, leaf);
+  const Scan& s = *outcome.map_cloud;
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) out.emplace_back(s.x[i], s.y[i], s.z[i]);
+  return out;
+}
+
 std::vector<Eigen::Vector3d> calibrationCloudInMap(const pipeline::CalibrationDataset& dataset,
                                                    const Pose& T_mapping_calib) {
   std::vector<Eigen::Vector3d> out;
@@ -60,7 +69,7 @@ void writeCloudPcd(const std::filesystem::path& path, const std::vector<Eigen::V
 }
 
 void writeCalibrationClouds(const std::filesystem::path& dir, const CalibrationOutcome& outcome, double map_leaf) {
-  writeCloudPcd(dir / "map.pcd", mapCloud(outcome.datasets, map_leaf));
+  writeCloudPcd(dir / "map.pcd", outcomeMapCloud(outcome, map_leaf));
   for (const auto& d : outcome.datasets) {
     writeCloudPcd(dir / (d.calibration_sensor + "_before.pcd"), calibrationCloudInMap(d, d.T_mapping_calib_guess));
     const LidarLidarResult* r = outcome.lidar(d.calibration_sensor);

@@ -118,7 +118,7 @@ RgbImage renderOverview(const CalibrationOutcome& o, int panel_size) {
   img.height = panel_size + header;
   img.rgb.assign(std::size_t(img.width) * std::size_t(img.height) * 3, 18);
 
-  const auto map = mapCloud(o.datasets, 0.05);
+  const auto map = outcomeMapCloud(o, 0.05);
   std::vector<std::vector<Eigen::Vector3d>> before, after;
   for (const auto& d : o.datasets) {
     before.push_back(calibrationCloudInMap(d, d.T_mapping_calib_guess));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "parameter_table.hpp"
 
@@ -157,6 +158,30 @@ Pose readExtrinsic(const Reader& r, const YAML::Node& n, const std::string& sens
   return fromXyzRpy({v[0], v[1], v[2], v[3], v[4], v[5]});
 }
 
+VehicleFootprint readVehicle(const Reader& r, const YAML::Node& n) {
+  r.requireMap(n, "vehicle");
+  r.checkKeys(n, {"length", "width", "rear_overhang"}, "vehicle");
+  VehicleFootprint f;
+  const auto positive = [&](const char* key, double& value, double max) {
+    if (!n[key]) return;
+    value = r.number(n[key], key);
+    r.inRange(n[key], key, value, 0.1, max);
+  };
+  positive("length", f.length, 100.0);
+  positive("width", f.width, 20.0);
+  if (n["rear_overhang"]) {
+    f.rear_overhang = r.number(n["rear_overhang"], "rear_overhang");
+    r.inRange(n["rear_overhang"], "rear_overhang", f.rear_overhang, -100.0, 100.0);
+  }
+  if (f.rear_overhang >= f.length) {
+    std::ostringstream msg;
+    msg << "vehicle: rear_overhang (" << f.rear_overhang << " m) must be less than length (" << f.length
+        << " m): base_link would lie ahead of the front bumper";
+    r.fail(n, msg.str());
+  }
+  return f;
+}
+
 void readParameters(const Reader& r, const YAML::Node& n, Parameters& params,
                     std::vector<std::string>& warnings) {
   r.requireMap(n, "parameters");
@@ -216,6 +241,17 @@ void checkConsistency(const Reader& r, const YAML::Node& root, const RigConfig& 
     r.fail(params, "min_calibration_range must be below max_calibration_range");
   if (p.lidar_calibration_min_frames > p.lidar_calibration_max_frames)
     r.fail(params, "lidar_calibration_min_frames must not exceed lidar_calibration_max_frames");
+  const std::pair<double, double> crop[] = {{p.base_lidar_crop_box_min_x, p.base_lidar_crop_box_max_x},
+                                            {p.base_lidar_crop_box_min_y, p.base_lidar_crop_box_max_y},
+                                            {p.base_lidar_crop_box_min_z, p.base_lidar_crop_box_max_z}};
+  for (int axis = 0; axis < 3; ++axis)
+    if (crop[axis].first >= crop[axis].second) {
+      const char name = "xyz"[axis];
+      std::ostringstream msg;
+      msg << "base_lidar_crop_box_min_" << name << " (" << crop[axis].first << ") must be below base_lidar_crop_box_max_"
+          << name << " (" << crop[axis].second << ")" << (root["vehicle"] ? " (the vehicle footprint sets the bounds not named)" : "");
+      r.fail(params, msg.str());
+    }
 }
 
 }  // namespace
@@ -232,7 +268,7 @@ RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
     throw ConfigError({file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + e.msg);
   }
   r.requireMap(root, "a rig file");
-  r.checkKeys(root, {"rig", "sensors", "roles", "initial_extrinsics", "parameters"}, "the rig file");
+  r.checkKeys(root, {"rig", "sensors", "roles", "initial_extrinsics", "vehicle", "parameters"}, "the rig file");
 
   RigConfig rig;
   rig.file = file;
@@ -282,6 +318,9 @@ RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
     }
   }
 
+  // The footprint first: a base_lidar_crop_box_* parameter named in the file then overrides its bound.
+  if (const YAML::Node vehicle = root["vehicle"]) rig.vehicle = readVehicle(r, vehicle);
+  setCropBoxFromFootprint(rig.vehicle, rig.parameters);
   if (const YAML::Node params = root["parameters"]) readParameters(r, params, rig.parameters, rig.warnings);
   checkConsistency(r, root, rig);
   return rig;

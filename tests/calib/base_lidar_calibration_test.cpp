@@ -7,6 +7,15 @@
 namespace rigcal::calib {
 namespace {
 
+// Upstream's ±20 m crop box: these scenes spread the ground over ±15 m (and put a wall 5 m ahead), wider
+// than the default vehicle footprint.
+config::Parameters wideBox() {
+  config::Parameters p;
+  p.base_lidar_crop_box_min_x = p.base_lidar_crop_box_min_y = p.base_lidar_crop_box_min_z = -20.0;
+  p.base_lidar_crop_box_max_x = p.base_lidar_crop_box_max_y = p.base_lidar_crop_box_max_z = 20.0;
+  return p;
+}
+
 // Points in the lidar frame of a scene in base_link: a ground plane (z = 0) with 2 mm noise, an
 // optional large wall, and clutter. `truth` is T_base_lidar.
 std::vector<Eigen::Vector3d> scene(const Pose& truth, bool big_wall, bool ground = true) {
@@ -45,7 +54,7 @@ void expectMatchesTruth(const BaseLidarResult& r, const Pose& truth, const Pose&
 TEST(BaseLidarCalibration, RecoversHeightRollPitchFromAPerturbedGuess) {
   const Pose truth = fromXyzRpy({1.2, 0.1, 1.85, deg2rad(2.0), deg2rad(-3.0), deg2rad(30.0)});
   const Pose initial = fromXyzRpy({1.25, 0.05, 2.15, deg2rad(-3.0), deg2rad(2.0), deg2rad(32.0)});
-  const BaseLidarResult r = calibrateBaseLidar(scene(truth, false), initial, config::Parameters{});
+  const BaseLidarResult r = calibrateBaseLidar(scene(truth, false), initial, wideBox());
   expectMatchesTruth(r, truth, initial);
   EXPECT_EQ(r.plane.attempts, 1);
   EXPECT_GT(r.plane.normal.dot(initial.linear().transpose() * Eigen::Vector3d::UnitZ()), 0.99);
@@ -54,7 +63,7 @@ TEST(BaseLidarCalibration, RecoversHeightRollPitchFromAPerturbedGuess) {
 TEST(BaseLidarCalibration, RejectsADominantWallThenFindsTheGround) {
   const Pose truth = fromXyzRpy({0, 0, 1.5, deg2rad(1.0), deg2rad(1.0), 0});
   const Pose initial = fromXyzRpy({0, 0, 1.7, 0, 0, 0});
-  const BaseLidarResult r = calibrateBaseLidar(scene(truth, true), initial, config::Parameters{});
+  const BaseLidarResult r = calibrateBaseLidar(scene(truth, true), initial, wideBox());
   expectMatchesTruth(r, truth, initial);
   EXPECT_GE(r.plane.attempts, 2) << "the wall is found first and rejected by its normal";
 }
@@ -62,7 +71,7 @@ TEST(BaseLidarCalibration, RejectsADominantWallThenFindsTheGround) {
 TEST(BaseLidarCalibration, NormalIsOrientedUpForAnUpsideDownLidar) {
   const Pose truth = fromXyzRpy({0, 0, 2.0, M_PI - deg2rad(1.0), deg2rad(0.5), deg2rad(10)});
   const Pose initial = fromXyzRpy({0, 0, 2.2, M_PI, 0, deg2rad(10)});
-  const BaseLidarResult r = calibrateBaseLidar(scene(truth, false), initial, config::Parameters{});
+  const BaseLidarResult r = calibrateBaseLidar(scene(truth, false), initial, wideBox());
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_NEAR(r.T_base_lidar.translation().z(), 2.0, 0.01);
   EXPECT_LT(rotationAngleBetween(r.T_base_lidar, truth), deg2rad(0.05));
@@ -71,7 +80,7 @@ TEST(BaseLidarCalibration, NormalIsOrientedUpForAnUpsideDownLidar) {
 TEST(BaseLidarCalibration, OverwriteXyYawCopiesTheInitialGuess) {
   const Pose truth = fromXyzRpy({1.0, 0.0, 1.8, 0.01, 0.02, 0.3});
   const Pose initial = fromXyzRpy({1.3, -0.2, 1.6, 0.0, 0.0, 0.25});
-  config::Parameters p;
+  config::Parameters p = wideBox();
   p.base_lidar_overwrite_xy_yaw = true;
   const BaseLidarResult r = calibrateBaseLidar(scene(truth, false), initial, p);
   ASSERT_TRUE(r.ok);
@@ -84,18 +93,18 @@ TEST(BaseLidarCalibration, OverwriteXyYawCopiesTheInitialGuess) {
 
 TEST(BaseLidarCalibration, NoGroundIsAClearFailure) {
   const Pose truth = fromXyzRpy({0, 0, 1.5, 0, 0, 0});
-  const BaseLidarResult r = calibrateBaseLidar(scene(truth, false, false), truth, config::Parameters{});
+  const BaseLidarResult r = calibrateBaseLidar(scene(truth, false, false), truth, wideBox());
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.failure.find("no ground plane"), std::string::npos) << r.failure;
   EXPECT_EQ(r.failure.find('\n'), std::string::npos);
-  EXPECT_FALSE(calibrateBaseLidar({}, truth, config::Parameters{}).ok);
+  EXPECT_FALSE(calibrateBaseLidar({}, truth, wideBox()).ok);
 }
 
 TEST(BaseLidarCalibration, SameInputSameResult) {
   const Pose truth = fromXyzRpy({0, 0, 1.5, 0.02, -0.01, 0});
   const auto points = scene(truth, true);
-  const BaseLidarResult a = calibrateBaseLidar(points, Pose::Identity(), config::Parameters{});
-  const BaseLidarResult b = calibrateBaseLidar(points, Pose::Identity(), config::Parameters{});
+  const BaseLidarResult a = calibrateBaseLidar(points, Pose::Identity(), wideBox());
+  const BaseLidarResult b = calibrateBaseLidar(points, Pose::Identity(), wideBox());
   ASSERT_TRUE(a.ok);
   EXPECT_TRUE(a.T_base_lidar.matrix() == b.T_base_lidar.matrix());
 }

@@ -43,11 +43,38 @@ TEST(CalibrateCommand, NeitherPcapNorLiveIsAUsageError) {
   EXPECT_NE(r.err.find("--pcap or --live"), std::string::npos) << r.err;
 }
 
-TEST(CalibrateCommand, MissingPcapIsAnInputErrorNamingTheFile) {
+// The pipeline options of `rigcal map` work here too: --cores pins, --stats writes the stage latencies.
+TEST(CalibrateCommand, StatsAndCoresLikeRigcalMap) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/vlp16_20hz_veloview.pcap");
+  TempDir dir;
+  const auto stats = dir / "stats.json";
+  const auto r = runRigcal({"calibrate", "--config", writeRig(dir, "  min_mapping_pointcloud_size: 1000\n").string(),
+                            "--pcap", pcap.string(), "--out", (dir / "out").string(), "--cores", "0", "--stats",
+                            stats.string()});
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;  // `left` sends nothing: not enough data, but mapped
+  ASSERT_TRUE(std::filesystem::exists(stats)) << r.err;
+  std::ifstream in(stats);
+  const auto j = nlohmann::json::parse(in);
+  ASSERT_TRUE(j.contains("stages")) << j.dump(2);
+  bool mapper = false;
+  for (const auto& s : j["stages"])
+    if (s["name"] == "mapper") mapper = s["processed"].get<int>() > 10;
+  EXPECT_TRUE(mapper) << "the mapper's stats: " << j.dump(2);
+  EXPECT_NE(r.out.find("mapper"), std::string::npos) << "the stats table on stdout: " << r.out;
+  const auto bad = runRigcal({"calibrate", "--config", writeRig(dir).string(), "--pcap", pcap.string(), "--cores",
+                              "0,x", "--out", (dir / "out2").string()});
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--cores"), std::string::npos) << bad.err;
+  const auto both = runRigcal({"calibrate", "--config", writeRig(dir).string(), "--pcap", pcap.string(), "--shm"});
+  EXPECT_EQ(both.exit_code, 2) << both.err;
+}
+
+// --pcap is checked with the other pipeline options (as `rigcal map`): a usage error naming the file.
+TEST(CalibrateCommand, MissingPcapIsAUsageErrorNamingTheFile) {
   TempDir dir;
   const auto r = runRigcal({"calibrate", "--config", writeRig(dir).string(), "--pcap", (dir / "nope.pcap").string(),
                             "--out", (dir / "out").string()});
-  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("nope.pcap"), std::string::npos) << r.err;
 }
 

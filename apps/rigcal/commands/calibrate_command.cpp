@@ -1,7 +1,8 @@
-// `rigcal calibrate --config RIG (--pcap F | --live) [--out DIR] [--deadline S] [--realtime]`: the main
-// job. Mapping starts at once; each calibration lidar is calibrated (on its own thread, while mapping goes
-// on) as soon as its frame budget is full, the others at the end of input; then base-lidar calibration,
-// the outputs in --out, and a summary table. Ctrl-C ends the input early and calibrates what has enough
+// `rigcal calibrate --config RIG (--pcap F [--rate R] | --live | --shm) [--out DIR] [--deadline S] [--realtime]
+// [--stats FILE.json] [--pin] [--cores 0,1]`: the main job (input, pinning and stats options as `rigcal map`).
+// Mapping starts at once; each calibration lidar is calibrated (on its own thread, while mapping goes on) as
+// soon as its frame budget is full, the others at the end of input; then base-lidar calibration, the outputs
+// in --out, and a summary table. Ctrl-C ends the input early and calibrates what has enough
 // frames; a lidar without enough frames is named with what is missing (exit 5, partial report).
 #include <unistd.h>
 
@@ -10,12 +11,15 @@
 #include <cstdio>
 #include <deque>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../pipeline_options.hpp"
 #include "../stop_signals.hpp"
 #include "rigcal/calib/base_lidar_calibration.hpp"
 #include "rigcal/calib/base_lidar_multi.hpp"
@@ -37,12 +41,19 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct CalibrateOptions {
-  std::string config, pcap, out = "rigcal-out";
-  bool live = false, realtime = false;
+  std::string config, out = "rigcal-out";
+  PipelineCliOptions pipeline;
   double deadline = -1.0;  // < 0: the rig's calibration_deadline_s
 };
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// The pipeline's progress line and how full the calibration lidars' frame budgets are.
+std::string progressLine(const pipeline::PipelineProgress& p) {
+  std::ostringstream o;
+  o << p.line() << " | budget " << std::fixed << std::setprecision(0) << 100.0 * p.budgetFill() << '%';
+  return o.str();
+}
 
 /// Calibrates the datasets the pipeline hands over, on its own thread, while mapping goes on. Datasets
 /// that arrive together share one calibration_deadline_s (CalibrationBudget).
@@ -112,17 +123,11 @@ void run(const CalibrateOptions& o) {
     throw CommandFailed(kExitConfig, e.what());
   }
   if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
-  if (!o.live && !std::filesystem::is_regular_file(o.pcap))
-    throw CommandFailed(kExitInput, o.pcap + ": no such capture file");
+  const pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
+  const bool realtime = po.mode == pipeline::PipelineMode::kRealtime;
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec) throw CommandFailed(kExitInput, o.out + ": cannot create the output folder (" + ec.message() + ")");
-
-  pipeline::PipelineOptions po;
-  po.input = o.live ? pipeline::InputKind::kLive : pipeline::InputKind::kPcap;
-  po.pcap = o.pcap;
-  po.rate = o.realtime ? 1.0 : 0.0;
-  po.mode = (o.live || o.realtime) ? pipeline::PipelineMode::kRealtime : pipeline::PipelineMode::kOffline;
 
   StopSignals signals;
   CalibrationWorker worker(rig.parameters);
@@ -140,7 +145,7 @@ void run(const CalibrateOptions& o) {
   if (::isatty(STDERR_FILENO) != 0)
     progress = std::thread([&] {
       while (!input_done.load()) {
-        std::fprintf(stderr, "\r\033[K%s", pipe->progress().line().c_str());
+        std::fprintf(stderr, "\r\033[K%s", progressLine(pipe->progress()).c_str());
         std::fflush(stderr);
         for (int i = 0; i < 5 && !input_done.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
       }
@@ -157,8 +162,13 @@ void run(const CalibrateOptions& o) {
   if (progress.joinable()) progress.join();
   const double pipeline_seconds = since(t_start);
   const bool interrupted = StopSignals::requested();
+  if (interrupted) std::cerr << "interrupted: input ended early; calibrating the lidars that have enough frames\n";
   worker.finish();
 
+  // The mapper's snapshot (trajectory, the whole map voxelised, the dense cloud): seconds on a long drive.
+  const auto t_map = Clock::now();
+  const pipeline::MappingResult mapping = pipe->mapping();
+  const double map_seconds = since(t_map);
   calib::CalibrationOutcome outcome;
   outcome.rig_name = rig.name;
   outcome.base_frame = rig.roles.base_frame;
@@ -168,11 +178,11 @@ void run(const CalibrateOptions& o) {
   outcome.deadline_s = rig.parameters.calibration_deadline_s;
   outcome.datasets = worker.datasets;
   outcome.lidars = worker.results;
+  outcome.map_cloud = mapping.map_cloud;
 
   // Base-lidar: the ground fitted at keyframes spread along the path (the map in each keyframe's lidar
   // frame) and combined: on bumpy ground one keyframe's plane carries the body's tilt at that spot.
   const auto t_base = Clock::now();
-  const pipeline::MappingResult mapping = pipe->mapping();
   if (rig.parameters.calibrate_base_frame && mapping.map_cloud != nullptr && mapping.last_keyframe_frame >= 0) {
     std::vector<Pose> keyframes;
     for (const auto& f : mapping.trajectory)
@@ -186,15 +196,19 @@ void run(const CalibrateOptions& o) {
   const double base_seconds = since(t_base);
 
   const auto progress_now = pipe->progress();
-  outcome.input_summary = {{"source", o.live ? std::string("live") : o.pcap},
-                           {"mode", o.live || o.realtime ? "realtime" : "offline"},
+  const std::string source = po.input == pipeline::InputKind::kPcap ? po.pcap.string()
+                             : po.input == pipeline::InputKind::kLive ? std::string("live")
+                                                                       : std::string("shm");
+  outcome.input_summary = {{"source", source},
+                           {"mode", realtime ? "realtime" : "offline"},
                            {"mapping_scans", std::to_string(progress_now.mapping_scans)},
                            {"keyframes", std::to_string(progress_now.keyframes)},
                            {"lost_frames", std::to_string(progress_now.lost_frames)},
                            {"interrupted", interrupted ? "yes" : "no"}};
   for (const auto& l : progress_now.lidars)
     outcome.input_summary.emplace_back(l.sensor + "_scans", std::to_string(l.scans));
-  outcome.stage_seconds = {{"pipeline", pipeline_seconds}, {"lidar_lidar", worker.seconds}, {"base_lidar", base_seconds}};
+  outcome.stage_seconds = {{"pipeline", pipeline_seconds}, {"lidar_lidar", worker.seconds},
+                          {"map", map_seconds}, {"base_lidar", base_seconds}};
 
   const auto shortfalls = pipe->shortfalls();
   for (const auto& sf : shortfalls) outcome.input_summary.emplace_back(sf.sensor + "_missing", sf.message);
@@ -211,6 +225,7 @@ void run(const CalibrateOptions& o) {
   } catch (const std::exception& e) {
     throw CommandFailed(kExitFailure, e.what());
   }
+  if (!o.pipeline.stats_file.empty()) reportStats(o.pipeline, pipe->stats());
   std::cout << calib::summaryTable(outcome) << "outputs in " << out.string() << "\n";
 
   if (!shortfalls.empty()) {
@@ -234,17 +249,13 @@ void addCalibrateCommand(CLI::App& app) {
   auto o = std::make_shared<CalibrateOptions>();
   CLI::App* cmd = app.add_subcommand("calibrate", "Map with the mapping lidar and calibrate the rig (the main job).");
   cmd->add_option("--config", o->config, "rig YAML file")->required()->check(CLI::ExistingFile);
-  auto* pcap = cmd->add_option("--pcap", o->pcap, "read this pcap/pcapng capture");
-  auto* live = cmd->add_flag("--live", o->live, "listen on the sensors' UDP ports");
-  pcap->excludes(live);
-  live->excludes(pcap);
+  addPipelineOptions(*cmd, o->pipeline);
   cmd->add_option("--out", o->out, "output folder (default rigcal-out)");
   cmd->add_option("--deadline", o->deadline, "seconds for the lidar-lidar calibration (calibration_deadline_s)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--realtime", o->realtime, "replay the pcap at its recorded rate (real-time pipeline)");
   cmd->footer(kExitCodesHelp);
   cmd->callback([o, cmd] {
-    if (o->pcap.empty() && !o->live) throw CLI::RequiredError("--pcap or --live");
+    if (o->pipeline.pcap.empty() && !o->pipeline.live && !o->pipeline.shm) throw CLI::RequiredError("--pcap or --live or --shm");
     (void)cmd;
     run(*o);
   });

@@ -2,6 +2,7 @@
 // Everything one calibration run produced, in one place for the writers (calibration.yaml, report.json,
 // clouds, overview.png, the stdout summary).
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -10,6 +11,7 @@
 #include "rigcal/calib/base_lidar_calibration.hpp"
 #include "rigcal/calib/lidar_lidar_calibration.hpp"
 #include "rigcal/core/pose.hpp"
+#include "rigcal/core/scan.hpp"
 #include "rigcal/pipeline/calibration_dataset.hpp"
 
 namespace rigcal::calib {
@@ -23,6 +25,9 @@ struct CalibrationOutcome {
   std::optional<BaseLidarResult> base;                // when base-lidar calibration ran
   std::vector<pipeline::CalibrationDataset> datasets; // one per calibration lidar (may lack a result)
   std::vector<LidarLidarResult> lidars;               // one per dataset that was calibrated
+  /// The mapper's whole map (map frame, already voxelised): map.pcd and the overview draw it as it is.
+  /// Null when the caller has none (then the datasets' mapping clouds are aggregated instead).
+  std::shared_ptr<const Scan> map_cloud;
   double deadline_s = 0.0;
   std::vector<std::pair<std::string, double>> stage_seconds;  // whole-run stages (pipeline, calibration, outputs)
   std::vector<std::pair<std::string, std::string>> input_summary;  // source, scans, keyframes, ...

@@ -1,6 +1,6 @@
 #pragma once
-// The clouds a user opens next to the result: map.pcd (the mapping lidar's clouds around the selected
-// keyframes, in the map frame) and, per calibration lidar, <name>_before.pcd / <name>_after.pcd (its
+// The clouds a user opens next to the result: map.pcd (the mapper's map, or else the mapping lidar's
+// clouds around the selected keyframes, in the map frame) and, per calibration lidar, <name>_before.pcd / <name>_after.pcd (its
 // selected frames placed in the same map frame through the initial and the calibrated extrinsic).
 #include <filesystem>
 #include <vector>
@@ -15,6 +15,10 @@ namespace rigcal::calib {
 
 /// The mapping clouds of all datasets (each stored frame once), in the map frame, voxelised at `leaf`.
 std::vector<Eigen::Vector3d> mapCloud(const std::vector<pipeline::CalibrationDataset>& datasets, double leaf);
+
+/// The outcome's map: its map_cloud as it is when set (no copy through a voxel grid), else
+/// mapCloud(datasets, leaf).
+std::vector<Eigen::Vector3d> outcomeMapCloud(const CalibrationOutcome& outcome, double leaf);
 
 /// A calibration lidar's selected frames (deskewed), in the map frame through T_mapping_calib.
 std::vector<Eigen::Vector3d> calibrationCloudInMap(const pipeline::CalibrationDataset& dataset,

@@ -66,12 +66,15 @@ struct Parameters {
 
   // Base-lidar calibration
   bool calibrate_base_frame = false;
-  double base_lidar_crop_box_min_x = -20.0;
-  double base_lidar_crop_box_min_y = -20.0;
-  double base_lidar_crop_box_min_z = -20.0;
-  double base_lidar_crop_box_max_x = 20.0;
-  double base_lidar_crop_box_max_y = 20.0;
-  double base_lidar_crop_box_max_z = 20.0;
+  // The crop box (base_link) defaults to the default VehicleFootprint's (vehicle_footprint.hpp), not
+  // upstream's ±20 m: on bumpy ground a wide box fits the terrain's mean tilt, not the wheels' ground.
+  // A rig's `vehicle:` section derives all six; a base_lidar_crop_box_* parameter overrides its one bound.
+  double base_lidar_crop_box_min_x = -1.5;
+  double base_lidar_crop_box_min_y = -1.5;
+  double base_lidar_crop_box_min_z = -1.0;
+  double base_lidar_crop_box_max_x = 4.0;
+  double base_lidar_crop_box_max_y = 1.5;
+  double base_lidar_crop_box_max_z = 0.5;
   double base_lidar_max_inlier_distance = 0.01;
   int base_lidar_max_iterations = 1000;
   int base_lidar_min_plane_points = 1000;

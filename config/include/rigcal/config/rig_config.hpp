@@ -10,6 +10,7 @@
 
 #include "rigcal/config/config_error.hpp"
 #include "rigcal/config/parameters.hpp"
+#include "rigcal/config/vehicle_footprint.hpp"
 #include "rigcal/core/pose.hpp"
 #include "rigcal/core/time.hpp"
 
@@ -45,7 +46,8 @@ struct RigConfig {
   std::vector<SensorConfig> sensors;
   Roles roles;
   std::map<std::string, Pose> initial_T_base_sensor;  // every sensor has one
-  Parameters parameters;
+  VehicleFootprint vehicle;                           // `vehicle:`, else the default outline
+  Parameters parameters;                              // crop box: from `vehicle`, unless set by name
   std::vector<std::string> warnings;                  // accepted but noteworthy (ignored upstream keys)
 
   [[nodiscard]] const SensorConfig& sensor(const std::string& name) const;

@@ -1,0 +1,147 @@
+// The run: the most informative frame first, then the others, the batched ICP, the re-deskew and
+// whatever time is left for the exhaustive ensemble; the all-frames scores that pick the best candidate.
+#include "lidar_lidar_calibrator.hpp"
+
+#include <sstream>
+
+#include "rigcal/calib/calibration_scheduler.hpp"
+
+namespace rigcal::calib::detail {
+
+void Calibrator::run() {
+  const auto t0 = Clock::now();
+  out_.candidates = {data_.T_mapping_calib_guess};
+  best_ = data_.T_mapping_calib_guess;
+  // The most informative frame first, alone: its ensemble gives the big correction early.
+  std::size_t next = 0;
+  while (frames_.empty() && next < data_.frames.size() && !stopped()) buildFrame(next++);
+  double target_seconds = since(t0);
+  if (frames_.empty()) {
+    out_.failure = out_.deadline_reached ? "deadline reached before any calibration frame's target was built"
+                                         : "no calibration frame has a usable source and target";
+    out_.stage_seconds.emplace_back("targets", target_seconds);
+    return;
+  }
+  rescore();
+  out_.initial_score = initial_score_;
+  double ensemble_seconds = 0.0, batched_seconds = 0.0;
+  auto t = Clock::now();
+  frameEnsemble(0, /*exhaustive=*/false);
+  ensemble_seconds += since(t);
+  // Then every other frame, scored together from now on.
+  t = Clock::now();
+  const std::size_t first_frames = frames_.size();
+  while (next < data_.frames.size() && !stopped()) {
+    // A frame's whole preparation (crop, voxels, target) as long as the last one's, or it waits.
+    if (!fits(deadline_, 1.2 * last_build_seconds_)) {
+      out_.deadline_reached = true;
+      break;
+    }
+    buildFrame(next++);
+  }
+  target_seconds += since(t);
+  // Rescoring the guess and the best over the grown set costs two scores of the new size.
+  const double grown = double(frames_.size()) / double(first_frames);
+  if (frames_.size() > first_frames && fits(deadline_, 2.5 * grown * score_seconds_)) rescore();
+  else if (frames_.size() > first_frames) {
+    // No time to score the grown set: keep the frames the scores were computed on.
+    frames_.resize(first_frames);
+    out_.frames_used.resize(first_frames);
+    out_.deadline_reached = true;
+  }
+  t = Clock::now();
+  if (!stopped()) batchedChain(best_);
+  batched_seconds += since(t);
+  t = Clock::now();
+  for (std::size_t k = 1; k < frames_.size() && !stopped(); ++k) frameEnsemble(k, false);
+  ensemble_seconds += since(t);
+  t = Clock::now();
+  if (!stopped()) finalStep();
+  const double final_seconds = since(t);
+  // Whatever time is left: upstream's exhaustive ensemble (every registrator from every candidate),
+  // which guards against a wrong basin; a better result gets the final batched refinement too.
+  t = Clock::now();
+  const Pose before_exhaustive = best_;
+  for (std::size_t k = 0; k < frames_.size() && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
+  if (!samePose(before_exhaustive, best_) && !stopped()) batchedChain(best_);
+  ensemble_seconds += since(t);
+  out_.stage_seconds = {{"targets", target_seconds},
+                        {"ensemble", ensemble_seconds},
+                        {"batched", batched_seconds},
+                        {"redeskew_final", final_seconds}};
+
+  out_.T_mapping_calib = best_;
+  out_.final_score = best_score_;
+  if (!finitePose(best_)) {  // cannot happen (registrations never return NaN) but never hand one out
+    out_.T_mapping_calib = data_.T_mapping_calib_guess;
+    out_.final_score = out_.initial_score;
+  }
+  out_.ok = out_.final_score.betterThan(out_.initial_score);
+  if (!out_.ok) {
+    std::ostringstream msg;
+    msg << "no registration beat the initial guess's score (" << out_.initial_score.value << " m², inliers "
+        << out_.initial_score.inlier_ratio << ")" << (out_.deadline_reached ? " before the deadline" : "");
+    out_.failure = msg.str();
+  }
+}
+
+bool Calibrator::stopped() {
+  if (deadline_.expired()) out_.deadline_reached = true;
+  return out_.deadline_reached;
+}
+
+void Calibrator::rescore() {
+  rebuildScorePairs();
+  const auto ts = Clock::now();
+  initial_score_ = score(data_.T_mapping_calib_guess);
+  score_seconds_ = since(ts);
+  best_score_ = samePose(best_, data_.T_mapping_calib_guess) ? initial_score_ : score(best_);
+  if (!best_score_.betterThan(initial_score_)) {
+    best_ = data_.T_mapping_calib_guess;
+    best_score_ = initial_score_;
+  }
+  out_.initial_score = initial_score_;
+}
+
+void Calibrator::rebuildScorePairs() {
+  std::vector<SourceTarget> full;
+  for (auto& f : frames_) full.push_back({&f.source, f.target.get()});
+  const std::size_t stride = scoreStride(full, opt_.score_points);
+  score_pairs_.clear();
+  for (auto& f : frames_) {
+    f.score_source.points.clear();
+    for (std::size_t i = 0; i < f.source.size(); i += stride) f.score_source.points.push_back(f.source.points[i]);
+    score_pairs_.push_back({&f.score_source, f.target.get()});
+  }
+}
+
+CalibrationScore Calibrator::score(const Pose& T) {
+  return scoreAllFrames(score_pairs_, T, params_.calibration_eval_max_corr_distance, 1, opt_.num_threads);
+}
+
+Deadline Calibrator::registrationDeadline() const {
+  if (deadline_.when() == Deadline::Clock::time_point::max()) return deadline_;
+  const auto reserve = std::chrono::duration_cast<Deadline::Clock::duration>(
+      std::chrono::duration<double>(2.5 * score_seconds_ + 0.01));
+  return Deadline::at(deadline_.when() - reserve, deadline_.token());
+}
+
+bool Calibrator::consider(const Pose& T, RegistratorRun* run) {
+  if (!finitePose(T) || !fits(deadline_, score_seconds_)) return false;
+  const CalibrationScore s = score(T);
+  if (run != nullptr) run->score = s.value;
+  if (s.betterThan(best_score_)) {
+    best_score_ = s;
+    best_ = T;
+  }
+  return true;
+}
+
+std::size_t Calibrator::addCandidate(const Pose& T) {
+  for (std::size_t c = 0; c < out_.candidates.size(); ++c)
+    if (samePose(out_.candidates[c], T)) return c;
+  out_.candidates.push_back(T);
+  return out_.candidates.size() - 1;
+}
+
+}  // namespace rigcal::calib::detail

@@ -1,0 +1,98 @@
+#pragma once
+// The bounded-time lidar-lidar calibration of one dataset (calibrateLidarLidar's engine), one concept per
+// source file: the run's order of work and the scores (lidar_lidar_calibrator.cpp), each frame's source and
+// augmented target (lidar_lidar_frames.cpp), the per-frame ensemble and the batched ICP
+// (lidar_lidar_ensemble.cpp). Private to calib/.
+#include <chrono>
+#include <cstddef>
+#include <memory>
+#include <set>
+#include <tuple>
+#include <vector>
+
+#include "rigcal/calib/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar_calibration.hpp"
+
+namespace rigcal::calib::detail {
+
+using Clock = std::chrono::steady_clock;
+using registration::Deadline;
+using registration::PointCloud;
+using registration::SourceTarget;
+using registration::Target;
+
+inline double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+inline bool finitePose(const Pose& T) { return T.matrix().allFinite(); }
+
+/// Two starts closer than this give the same registration result: run it once.
+inline bool samePose(const Pose& a, const Pose& b) {
+  return (a.translation() - b.translation()).norm() < 1e-4 && rotationAngleBetween(a, b) < deg2rad(0.005);
+}
+
+struct Frame {
+  std::size_t index = 0;  // in the dataset
+  PointCloud source;
+  PointCloud score_source;  // every stride-th point: what the all-frames score looks at
+  std::shared_ptr<const Target> target;
+};
+
+class Calibrator {
+ public:
+  Calibrator(const pipeline::CalibrationDataset& dataset, const config::Parameters& params, const Deadline& deadline,
+             const LidarLidarOptions& options, LidarLidarResult& out)
+      : data_(dataset), params_(params), deadline_(deadline), opt_(options), out_(out) {}
+
+  void run();
+
+ private:
+  bool stopped();
+
+  /// Source and augmented target of dataset frame i; a frame without enough points is skipped (noted).
+  void buildFrame(std::size_t i);
+
+  /// The initial guess's and the best's scores over the frames built so far (the set just grew).
+  void rescore();
+
+  void rebuildScorePairs();
+
+  CalibrationScore score(const Pose& T);
+
+  /// A registration stops early enough that its result can still be scored before the real deadline.
+  [[nodiscard]] Deadline registrationDeadline() const;
+
+  /// Scores a candidate over all frames and keeps it when it is the best so far; false when out of time.
+  bool consider(const Pose& T, RegistratorRun* run);
+
+  std::size_t addCandidate(const Pose& T);
+
+  /// Upstream's per-frame ensemble: each registrator in turn, its best result becoming a candidate.
+  /// Quick pass (exhaustive = false): each registrator from the frame's best candidate so far — the
+  /// chain NDT → GICP → ICP coarse → fine → ultra-fine that brings the largest improvement per second.
+  /// Exhaustive pass: each registrator from every candidate so far not yet tried with it on this frame.
+  void frameEnsemble(std::size_t k, bool exhaustive);
+
+  /// Batched ICP over all frames at 0.5 → 0.1 → 0.05 m from `start`.
+  void batchedChain(const Pose& start);
+
+  /// Re-deskews every frame with the best extrinsic, then batched ICP from {initial, best}.
+  void finalStep();
+
+  const pipeline::CalibrationDataset& data_;
+  const config::Parameters& params_;
+  const Deadline& deadline_;
+  const LidarLidarOptions& opt_;
+  LidarLidarResult& out_;
+  std::vector<Frame> frames_;
+  std::vector<SourceTarget> score_pairs_;
+  double score_seconds_ = 0.0;
+  // Target build cost per point; until measured, a pessimistic guess (measured 2–7 µs on a loaded 2-core box).
+  double seconds_per_point_ = 6e-6;
+  double last_build_seconds_ = 0.0;
+  CalibrationScore initial_score_;
+  std::set<std::tuple<std::size_t, int, std::size_t>> tried_;  // (frame, registrator, start) runs done
+  Pose best_ = Pose::Identity();
+  CalibrationScore best_score_;
+};
+
+}  // namespace rigcal::calib::detail

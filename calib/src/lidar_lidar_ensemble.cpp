@@ -1,0 +1,118 @@
+// The registrations: upstream's per-frame ensemble (NDT, GICP, ICP coarse/fine/ultra-fine), the batched ICP
+// over all frames and the final step after re-deskewing with the best extrinsic.
+#include "lidar_lidar_calibrator.hpp"
+
+#include <cmath>
+#include <cstdint>
+
+#include "rigcal/calib/calibration_deskew.hpp"
+#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_source.hpp"
+#include "rigcal/calib/ensemble_plan.hpp"
+
+namespace rigcal::calib::detail {
+
+void Calibrator::frameEnsemble(std::size_t k, bool exhaustive) {
+  const Frame& f = frames_[k];
+  const double d_eval = params_.calibration_eval_max_corr_distance;
+  std::size_t frame_best = addCandidate(best_);
+  double frame_best_score = scoreFrame(*f.target, f.source, out_.candidates[frame_best], d_eval, opt_.num_threads).value;
+  for (const Registrator r : perFrameRegistrators()) {
+    std::vector<std::size_t> starts;
+    if (exhaustive) {
+      for (std::size_t c = 0; c < out_.candidates.size(); ++c) starts.push_back(c);
+    } else {
+      starts.push_back(frame_best);
+    }
+    std::size_t reg_best = SIZE_MAX;
+    double reg_best_score = INFINITY;
+    for (const std::size_t start : starts) {
+      if (!tried_.insert({f.index, int(r), start}).second) continue;  // this run was done already
+      if (stopped()) return;
+      RegistratorRun run;
+      run.frame = int(f.index);
+      run.registrator = toString(r);
+      run.start = start;
+      const auto tr = Clock::now();
+      const auto res = runRegistrator(r, *f.target, f.source, out_.candidates[start], params_, opt_.num_threads,
+                                      registrationDeadline());
+      run.seconds = since(tr);
+      run.iterations = res.iterations;
+      run.status = std::string(registration::toString(res.status));
+      if (res.status != registration::Status::kInvalidInput &&
+          res.status != registration::Status::kTooFewCorrespondences && finitePose(res.T_target_source) &&
+          fits(deadline_, score_seconds_ / 2)) {
+        run.frame_score = scoreFrame(*f.target, f.source, res.T_target_source, d_eval, opt_.num_threads).value;
+        const std::size_t id = addCandidate(res.T_target_source);
+        if (run.frame_score < reg_best_score) {
+          reg_best_score = run.frame_score;
+          reg_best = id;
+        }
+      }
+      out_.runs.push_back(run);
+    }
+    if (reg_best != SIZE_MAX && reg_best_score < frame_best_score) {
+      frame_best_score = reg_best_score;
+      frame_best = reg_best;
+      // A better frame result competes at once on its score over all frames (recorded on its run),
+      // so a deadline in the next registrator does not lose it.
+      RegistratorRun* winner = nullptr;
+      for (auto it = out_.runs.rbegin(); it != out_.runs.rend() && it->frame == int(f.index); ++it)
+        if (it->frame_score == frame_best_score) winner = &*it;
+      if (!samePose(out_.candidates[frame_best], best_)) consider(out_.candidates[frame_best], winner);
+    }
+  }
+}
+
+void Calibrator::batchedChain(const Pose& start) {
+  std::vector<SourceTarget> pairs;
+  for (auto& f : frames_) pairs.push_back({&f.source, f.target.get()});
+  Pose T = start;
+  for (const double d : batchedDistances(params_)) {
+    if (stopped()) return;
+    RegistratorRun run;
+    run.registrator = "batched_icp";
+    run.max_distance = d;
+    run.start = addCandidate(T);
+    const auto tr = Clock::now();
+    const auto res = runBatched(pairs, T, d, params_, opt_.num_threads, registrationDeadline());
+    run.seconds = since(tr);
+    run.iterations = res.iterations;
+    run.status = std::string(registration::toString(res.status));
+    if (res.status == registration::Status::kInvalidInput || res.status == registration::Status::kTooFewCorrespondences ||
+        !finitePose(res.T_target_source)) {
+      out_.runs.push_back(run);
+      return;
+    }
+    T = res.T_target_source;
+    addCandidate(T);
+    consider(T, &run);
+    out_.runs.push_back(run);
+  }
+}
+
+void Calibrator::finalStep() {
+  if (opt_.redeskew && !samePose(best_, data_.T_mapping_calib_guess) && data_.trajectory.size() >= 2) {
+    std::vector<PointCloud> sources;
+    for (const auto& f : frames_) {
+      if (stopped()) return;
+      const Scan deskewed = deskewThroughMapping(*data_.frames[f.index].raw, data_.trajectory, best_);
+      SourceOptions so;
+      so.covariances = false;
+      sources.push_back(buildSource(deskewed, params_, so));
+    }
+    for (std::size_t k = 0; k < frames_.size(); ++k) frames_[k].source = std::move(sources[k]);
+    rebuildScorePairs();
+    // Scores under the new sources are not comparable with the old ones: rescore the best.
+    if (!fits(deadline_, score_seconds_)) {
+      out_.deadline_reached = true;
+      return;
+    }
+    best_score_ = score(best_);
+  }
+  const Pose best_before = best_;
+  batchedChain(data_.T_mapping_calib_guess);
+  batchedChain(best_before);
+}
+
+}  // namespace rigcal::calib::detail
