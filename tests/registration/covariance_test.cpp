@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <algorithm>
 #include <vector>
 
 #include "rigcal/registration/ndt_grid.hpp"
@@ -55,6 +56,17 @@ TEST(Covariance, SameResultWithTwoThreads) {
 // must give the tree's answer. Jittered so no two neighbours tie at the k-th distance (a tie may pick
 // either point); a far-away offset (UTM-like) and a few isolated points that the grid cannot vouch for
 // exercise the precision and the tree fallback.
+// True when, by exact (double) distances from point i, the neighbour at the boundary of its k-set and the
+// next one are equally far within float rounding (whether the set counts the point itself or not).
+bool kthNeighbourIsAFloatTie(const PointCloud& c, std::size_t i, int k) {
+  std::vector<double> d2;
+  d2.reserve(c.size());
+  for (const auto& p : c.points) d2.push_back((p.head<3>() - c.points[i].head<3>()).squaredNorm());
+  std::sort(d2.begin(), d2.end());
+  const auto tie = [&](std::size_t j) { return j + 1 < d2.size() && d2[j + 1] - d2[j] <= 1e-5 * d2[j + 1]; };
+  return tie(std::size_t(k) - 1) || tie(std::size_t(k));
+}
+
 TEST(Covariance, GridNeighbourhoodsEqualTheTrees) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> jitter(-0.02, 0.02);
@@ -69,13 +81,22 @@ TEST(Covariance, GridNeighbourhoodsEqualTheTrees) {
     const CovarianceStats grid = estimateCovariances(a);
     const CovarianceStats tree = estimateCovariances(b, KdTree(b.points));
     EXPECT_EQ(grid.without_neighborhood, tree.without_neighborhood);
-    std::size_t differ = 0;
+    std::size_t differ = 0, ties = 0;
     for (std::size_t i = 0; i < a.size(); ++i) {
       // Same neighbour set → the same sums in the same order up to the order of the set: 1e-9 allows that.
-      differ += (a.covariances[i] - b.covariances[i]).cwiseAbs().maxCoeff() > 1e-9 ||
-                (a.normals[i] - b.normals[i]).cwiseAbs().maxCoeff() > 1e-9;
+      if ((a.covariances[i] - b.covariances[i]).cwiseAbs().maxCoeff() <= 1e-9 &&
+          (a.normals[i] - b.normals[i]).cwiseAbs().maxCoeff() <= 1e-9)
+        continue;
+      // Both compare float distances, each compiler rounding its own way: where the k-th and the next
+      // neighbour are equally far to float precision, either is right. Anything else is a wrong answer.
+      if (kthNeighbourIsAFloatTie(a, i, CovarianceOptions{}.num_neighbors)) {
+        ++ties;
+        continue;
+      }
+      ++differ;
     }
     EXPECT_EQ(differ, 0u) << "of " << a.size() << " points, offset " << offset.transpose();
+    EXPECT_LE(ties, 3u) << "float ties are rare on jittered points";
   }
 }
 
