@@ -34,7 +34,7 @@ test-asan: deps
 test-tsan: deps
 	CXX=clang++ cmake -S . -B $(TSAN) $(GENERATOR) -DCMAKE_BUILD_TYPE=Debug -DRIGCAL_SANITIZE=thread
 	cmake --build $(TSAN) -j $(JOBS)
-	cd $(TSAN) && TSAN_OPTIONS=halt_on_error=1 $(CTEST)
+	cd $(TSAN) && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tests/tsan.supp" $(CTEST)
 
 demo: build
 	@scripts/demo $(BUILD)
