@@ -5,6 +5,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "rigcal/core/civil_date.hpp"
 #include "rigcal/drivers/hesai/hesai_packet.hpp"
 #include "rigcal/drivers/ouster/ouster_decoder.hpp"
 #include "rigcal/drivers/ouster/ouster_metadata.hpp"
@@ -28,19 +29,6 @@ void store(std::uint8_t* p, T v) {
 }
 
 std::int64_t floorMod(std::int64_t a, std::int64_t m) { return ((a % m) + m) % m; }
-
-// Proleptic Gregorian date of a day count since 1970-01-01 (the inverse of the era-based days-from-civil).
-void civilFromDays(std::int64_t z, std::int64_t& year, unsigned& month, unsigned& day) {
-  z += 719468;
-  const std::int64_t era = (z >= 0 ? z : z - 146096) / 146097;
-  const auto doe = unsigned(z - era * 146097);
-  const unsigned yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-  const unsigned doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-  const unsigned mp = (5 * doy + 2) / 153;
-  day = doy - (153 * mp + 2) / 5 + 1;
-  month = mp < 10 ? mp + 3 : mp - 9;
-  year = std::int64_t(yoe) + era * 400 + (month <= 2 ? 1 : 0);
-}
 
 enum class Vendor : std::uint8_t { kVelodyne, kOuster, kHesai };
 
@@ -83,15 +71,13 @@ struct PacketRestamper::Impl {
     const std::int64_t s = t_us >= 0 ? t_us / 1'000'000 : (t_us - 999'999) / 1'000'000;
     const std::int64_t days = s >= 0 ? s / 86400 : (s - 86399) / 86400;
     const std::int64_t in_day = s - days * 86400;
-    std::int64_t year = 0;
-    unsigned month = 0, day = 0;
-    civilFromDays(days, year, month, day);
-    if (year < 1900 || year > 1900 + 255) return false;
+    const CivilDate date = civilFromDays(days);
+    if (date.year < 1900 || date.year > 1900 + 255) return false;
     auto* tail = p.data() + (v.tail - p.data());  // the same bytes, writable
     const std::size_t date_at = hesai::tailDateOffset(*hesai_spec);
-    const std::uint8_t date[6] = {std::uint8_t(year - 1900), std::uint8_t(month), std::uint8_t(day),
-                                  std::uint8_t(in_day / 3600), std::uint8_t(in_day / 60 % 60), std::uint8_t(in_day % 60)};
-    std::memcpy(tail + date_at, date, 6);
+    const std::uint8_t fields[6] = {std::uint8_t(date.year - 1900), std::uint8_t(date.month), std::uint8_t(date.day),
+                                    std::uint8_t(in_day / 3600), std::uint8_t(in_day / 60 % 60), std::uint8_t(in_day % 60)};
+    std::memcpy(tail + date_at, fields, 6);
     store(tail + date_at + 6, std::uint32_t(t_us - s * 1'000'000));
     if (v.tail_crc_bytes > 0)
       store(tail + v.tail_crc_bytes, hesai::crc32Mpeg2({tail, v.tail_crc_bytes}));

@@ -6,6 +6,8 @@
 #include <immintrin.h>
 #endif
 
+#include "rigcal/core/civil_date.hpp"
+
 namespace rigcal::drivers::hesai {
 namespace {
 
@@ -91,16 +93,6 @@ struct CrcTables {
 const CrcTables& crcTables() {
   static const CrcTables tables;
   return tables;
-}
-
-// Days from 1970-01-01 to the given proleptic Gregorian date (era-based civil-date arithmetic).
-std::int64_t daysFromCivil(std::int64_t y, unsigned m, unsigned d) {
-  y -= m <= 2 ? 1 : 0;
-  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
-  const unsigned yoe = static_cast<unsigned>(y - era * 400);
-  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
-  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
 }
 
 void readTail(const std::uint8_t* tail, const TailLayout& at, PacketView& v) {

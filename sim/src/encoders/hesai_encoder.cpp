@@ -16,6 +16,7 @@
 
 #include "encoder_util.hpp"
 #include "encoders.hpp"
+#include "rigcal/core/civil_date.hpp"
 #include "rigcal/sim/random.hpp"
 
 namespace rigcal::sim::encoders {
@@ -25,19 +26,6 @@ constexpr std::size_t kPacketSize = 1080, kHeader = 12, kBlockBytes = 2 + 32 * 4
 constexpr int kBlocks = 8;
 constexpr TimeNs kT0AfterFirstRoundNs = 7 * 50'000 - 5'632;
 constexpr std::uint8_t kStrongestReturn = 0x37, kFactoryByte = 0x42;
-
-// Proleptic Gregorian date of a day count since 1970-01-01 (era-based civil-date arithmetic).
-void civilFromDays(std::int64_t z, std::int64_t& y, unsigned& m, unsigned& d) {
-  z += 719468;
-  const std::int64_t era = (z >= 0 ? z : z - 146096) / 146097;
-  const unsigned doe = unsigned(z - era * 146097);
-  const unsigned yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-  const unsigned doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-  const unsigned mp = (5 * doy + 2) / 153;
-  d = doy - (153 * mp + 2) / 5 + 1;
-  m = mp < 10 ? mp + 3 : mp - 9;
-  y = std::int64_t(yoe) + era * 400 + (m <= 2 ? 1 : 0);
-}
 
 class HesaiXt32Encoder final : public PacketEncoder {
  public:
@@ -85,13 +73,11 @@ class HesaiXt32Encoder final : public PacketEncoder {
     putU16le(tail + 11, rpm_);
     const TimeNs t0_us = floorDivNs(first.sensor_time_ns + kT0AfterFirstRoundNs + 500, 1000);
     const TimeNs seconds = floorDivNs(t0_us, 1'000'000);
-    std::int64_t year;
-    unsigned month, day;
-    civilFromDays(floorDivNs(seconds, 86'400), year, month, day);
+    const CivilDate date = civilFromDays(floorDivNs(seconds, 86'400));
     const TimeNs in_day = floorModNs(seconds, 86'400);
-    tail[13] = std::uint8_t(std::clamp<std::int64_t>(year - 1900, 0, 255));
-    tail[14] = std::uint8_t(month);
-    tail[15] = std::uint8_t(day);
+    tail[13] = std::uint8_t(std::clamp<std::int64_t>(date.year - 1900, 0, 255));
+    tail[14] = std::uint8_t(date.month);
+    tail[15] = std::uint8_t(date.day);
     tail[16] = std::uint8_t(in_day / 3600);
     tail[17] = std::uint8_t(in_day / 60 % 60);
     tail[18] = std::uint8_t(in_day % 60);
