@@ -121,6 +121,18 @@ struct Sym3 {
   }
 };
 
+/// Inverse of the symmetric 3x3 (f00 f01 f02 / f11 f12 / f22) by cofactors.
+inline Sym3 symmetricInverse(double f00, double f01, double f02, double f11, double f12, double f22) {
+  const double c00 = f11 * f22 - f12 * f12;
+  const double c01 = f02 * f12 - f01 * f22;
+  const double c02 = f01 * f12 - f02 * f11;
+  const double c11 = f00 * f22 - f02 * f02;
+  const double c12 = f01 * f02 - f00 * f12;
+  const double c22 = f00 * f11 - f01 * f01;
+  const double inv_det = 1.0 / (f00 * c00 + f01 * c01 + f02 * c02);
+  return {c00 * inv_det, c01 * inv_det, c02 * inv_det, c11 * inv_det, c12 * inv_det, c22 * inv_det};
+}
+
 /// GICP's weight (C_t + R·C_s·Rᵀ)⁻¹, written out: R·C_s (27 products), its upper triangle times Rᵀ (18),
 /// the cofactor inverse. About half the instructions of the same with generic Eigen 3x3 products.
 inline Sym3 fusedInverse(const Eigen::Matrix3d& R, const Sym3& s, const Sym3& t) {
@@ -134,14 +146,7 @@ inline Sym3 fusedInverse(const Eigen::Matrix3d& R, const Sym3& s, const Sym3& t)
   auto f = [&](int i, int j) { return a[i][0] * R(j, 0) + a[i][1] * R(j, 1) + a[i][2] * R(j, 2); };
   const double f00 = f(0, 0) + t.xx, f01 = f(0, 1) + t.xy, f02 = f(0, 2) + t.xz;
   const double f11 = f(1, 1) + t.yy, f12 = f(1, 2) + t.yz, f22 = f(2, 2) + t.zz;
-  const double c00 = f11 * f22 - f12 * f12;
-  const double c01 = f02 * f12 - f01 * f22;
-  const double c02 = f01 * f12 - f02 * f11;
-  const double c11 = f00 * f22 - f02 * f02;
-  const double c12 = f01 * f02 - f00 * f12;
-  const double c22 = f00 * f11 - f01 * f01;
-  const double inv_det = 1.0 / (f00 * c00 + f01 * c01 + f02 * c02);
-  return {c00 * inv_det, c01 * inv_det, c02 * inv_det, c11 * inv_det, c12 * inv_det, c22 * inv_det};
+  return symmetricInverse(f00, f01, f02, f11, f12, f22);
 }
 
 /// The same weight when the source covariance is I − v·vᵀ (how estimateCovariances builds them: plane-
@@ -151,14 +156,7 @@ inline Sym3 fusedInverseRank1(const Eigen::Matrix3d& R, const Eigen::Vector3d& v
   const Eigen::Vector3d u = R * v;
   const double f00 = t.xx + 1.0 - u.x() * u.x(), f01 = t.xy - u.x() * u.y(), f02 = t.xz - u.x() * u.z();
   const double f11 = t.yy + 1.0 - u.y() * u.y(), f12 = t.yz - u.y() * u.z(), f22 = t.zz + 1.0 - u.z() * u.z();
-  const double c00 = f11 * f22 - f12 * f12;
-  const double c01 = f02 * f12 - f01 * f22;
-  const double c02 = f01 * f12 - f02 * f11;
-  const double c11 = f00 * f22 - f02 * f02;
-  const double c12 = f01 * f02 - f00 * f12;
-  const double c22 = f00 * f11 - f01 * f01;
-  const double inv_det = 1.0 / (f00 * c00 + f01 * c01 + f02 * c02);
-  return {c00 * inv_det, c01 * inv_det, c02 * inv_det, c11 * inv_det, c12 * inv_det, c22 * inv_det};
+  return symmetricInverse(f00, f01, f02, f11, f12, f22);
 }
 
 /// v with C = I − v·vᵀ (v = 0 for C = I), if C has that form to rounding; false otherwise.
