@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "gicp_batch.hpp"
 #include "kernels.hpp"
 #include "rigcal/registration/parallel.hpp"
 
@@ -105,6 +106,17 @@ bool CorrespondenceObjective::match(const Target& target, std::size_t g, const E
       return found != kNone;
     }
   }
+  if (last == kNone) {
+    // A first search: the point will move too far before the next one for a margin to help (and the
+    // match found here seeds the graph walk next time), so the nearest alone will do, at a smaller bound.
+    Neighbor nb;
+    second_[g] = kNone;
+    margin_[g] = -1.0F;
+    if (!target.tree().nearest(q, max_sq_, &nb)) return false;
+    match_[g] = nb.index;
+    *j = nb.index;
+    return true;
+  }
   Neighbor nb[2];
   std::uint32_t hints[2];
   std::size_t num_hints = 0;
@@ -134,6 +146,7 @@ LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, con
   const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();
   LinearSystem sys;
   PointToPointSums p2p;
+  GicpBatch gicp;
   for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
     const std::size_t g = chunk.offset + (i - chunk.begin);
     const Eigen::Vector4d q4 = M * source.points[i];
@@ -154,11 +167,12 @@ LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, con
       sys.cost += e * e;
     } else if constexpr (K == Residual::kGicp) {
       const Sym3 t = Sym3::load(target.covarianceUpperFloat().data() + 6 * std::size_t{j});
-      const Sym3 w = source_axis_.empty() ? fusedInverse(R, source_cov_[g], t) : fusedInverseRank1(R, source_axis_[g], t);
-      weight_[g] = w;
-      const Eigen::Vector3d u = w.times(r);
-      addWeighted(w.full(), q, u, sys.H, sys.b);
-      sys.cost += r.dot(u);
+      if (source_axis_.empty()) {
+        gicp.add(q, r, fusedCovariance(R, source_cov_[g], t), Eigen::Vector3d::Zero(), &weight_[g]);
+      } else {  // C_s = I − v·vᵀ: R·C_s·Rᵀ = I − (R·v)(R·v)ᵀ
+        const Sym3 base{t.xx + 1.0, t.xy, t.xz, t.yy + 1.0, t.yz, t.zz + 1.0};
+        gicp.add(q, r, base, R * source_axis_[g], &weight_[g]);
+      }
     } else {
       p2p.add(q);
       sys.b.head<3>() += r;
@@ -170,6 +184,7 @@ LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, con
     sys.sum_sq_distance += d2;
   }
   if constexpr (K == Residual::kPointToPoint) p2p.finish(sys.H);
+  if constexpr (K == Residual::kGicp) gicp.finish(sys);
   mirrorUpper(sys.H);
   return sys;
 }

@@ -47,13 +47,6 @@ inline void addGradient(const Eigen::Vector3d& q, const Eigen::Vector3d& u, Vect
   b.tail<3>() += q.cross(u);
 }
 
-/// H += Jᵀ·W·J and b += Jᵀ·u with u = W·r: the GICP form.
-inline void addWeighted(const Eigen::Matrix3d& W, const Eigen::Vector3d& q, const Eigen::Vector3d& u, Matrix6d& H,
-                        Vector6d& b) {
-  addWeightedHessian(W, q, H);
-  addGradient(q, u, b);
-}
-
 /// One scalar residual e with gradient row j = [n, q × n]: H += jᵀj, b += jᵀe (point-to-plane).
 inline void addRow(const Vector6d& j, double e, Matrix6d& H, Vector6d& b) {
   for (int c = 0; c < 6; ++c) {
@@ -85,20 +78,6 @@ struct PointToPointSums {
 
 inline void mirrorUpper(Matrix6d& H) { H.triangularView<Eigen::StrictlyLower>() = H.transpose(); }
 
-/// (A)⁻¹ for a symmetric positive-definite 3x3, by cofactors (the fused GICP covariance).
-inline Eigen::Matrix3d inverseSymmetric(const Eigen::Matrix3d& A) {
-  const double c00 = A(1, 1) * A(2, 2) - A(1, 2) * A(1, 2);
-  const double c01 = A(0, 2) * A(1, 2) - A(0, 1) * A(2, 2);
-  const double c02 = A(0, 1) * A(1, 2) - A(0, 2) * A(1, 1);
-  const double c11 = A(0, 0) * A(2, 2) - A(0, 2) * A(0, 2);
-  const double c12 = A(0, 1) * A(0, 2) - A(0, 0) * A(1, 2);
-  const double c22 = A(0, 0) * A(1, 1) - A(0, 1) * A(0, 1);
-  const double inv_det = 1.0 / (A(0, 0) * c00 + A(0, 1) * c01 + A(0, 2) * c02);
-  Eigen::Matrix3d out;
-  out << c00, c01, c02, c01, c11, c12, c02, c12, c22;
-  return out * inv_det;
-}
-
 /// A symmetric 3x3 by its upper triangle: half the memory of a Matrix3d, and the GICP kernel below only
 /// touches what it needs.
 struct Sym3 {
@@ -114,28 +93,12 @@ struct Sym3 {
     return {xx * v.x() + xy * v.y() + xz * v.z(), xy * v.x() + yy * v.y() + yz * v.z(),
             xz * v.x() + yz * v.y() + zz * v.z()};
   }
-  [[nodiscard]] Eigen::Matrix3d full() const {
-    Eigen::Matrix3d m;
-    m << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-    return m;
-  }
 };
 
-/// Inverse of the symmetric 3x3 (f00 f01 f02 / f11 f12 / f22) by cofactors.
-inline Sym3 symmetricInverse(double f00, double f01, double f02, double f11, double f12, double f22) {
-  const double c00 = f11 * f22 - f12 * f12;
-  const double c01 = f02 * f12 - f01 * f22;
-  const double c02 = f01 * f12 - f02 * f11;
-  const double c11 = f00 * f22 - f02 * f02;
-  const double c12 = f01 * f02 - f00 * f12;
-  const double c22 = f00 * f11 - f01 * f01;
-  const double inv_det = 1.0 / (f00 * c00 + f01 * c01 + f02 * c02);
-  return {c00 * inv_det, c01 * inv_det, c02 * inv_det, c11 * inv_det, c12 * inv_det, c22 * inv_det};
-}
-
-/// GICP's weight (C_t + R·C_s·Rᵀ)⁻¹, written out: R·C_s (27 products), its upper triangle times Rᵀ (18),
-/// the cofactor inverse. About half the instructions of the same with generic Eigen 3x3 products.
-inline Sym3 fusedInverse(const Eigen::Matrix3d& R, const Sym3& s, const Sym3& t) {
+/// C_t + R·C_s·Rᵀ, written out: R·C_s (27 products), its upper triangle times Rᵀ (18). About half the
+/// instructions of the same with generic Eigen 3x3 products. (A rank-one source needs none of it: see
+/// GicpBatch.)
+inline Sym3 fusedCovariance(const Eigen::Matrix3d& R, const Sym3& s, const Sym3& t) {
   double a[3][3];
   for (int i = 0; i < 3; ++i) {
     const double r0 = R(i, 0), r1 = R(i, 1), r2 = R(i, 2);
@@ -144,19 +107,7 @@ inline Sym3 fusedInverse(const Eigen::Matrix3d& R, const Sym3& s, const Sym3& t)
     a[i][2] = r0 * s.xz + r1 * s.yz + r2 * s.zz;
   }
   auto f = [&](int i, int j) { return a[i][0] * R(j, 0) + a[i][1] * R(j, 1) + a[i][2] * R(j, 2); };
-  const double f00 = f(0, 0) + t.xx, f01 = f(0, 1) + t.xy, f02 = f(0, 2) + t.xz;
-  const double f11 = f(1, 1) + t.yy, f12 = f(1, 2) + t.yz, f22 = f(2, 2) + t.zz;
-  return symmetricInverse(f00, f01, f02, f11, f12, f22);
-}
-
-/// The same weight when the source covariance is I − v·vᵀ (how estimateCovariances builds them: plane-
-/// regularised, v = sqrt(1 − ε)·normal): R·C_s·Rᵀ = I − (R·v)(R·v)ᵀ, so rotating it costs one
-/// matrix-vector product instead of two 3x3 products.
-inline Sym3 fusedInverseRank1(const Eigen::Matrix3d& R, const Eigen::Vector3d& v, const Sym3& t) {
-  const Eigen::Vector3d u = R * v;
-  const double f00 = t.xx + 1.0 - u.x() * u.x(), f01 = t.xy - u.x() * u.y(), f02 = t.xz - u.x() * u.z();
-  const double f11 = t.yy + 1.0 - u.y() * u.y(), f12 = t.yz - u.y() * u.z(), f22 = t.zz + 1.0 - u.z() * u.z();
-  return symmetricInverse(f00, f01, f02, f11, f12, f22);
+  return {f(0, 0) + t.xx, f(0, 1) + t.xy, f(0, 2) + t.xz, f(1, 1) + t.yy, f(1, 2) + t.yz, f(2, 2) + t.zz};
 }
 
 /// v with C = I − v·vᵀ (v = 0 for C = I), if C has that form to rounding; false otherwise.
@@ -178,22 +129,6 @@ inline bool rankOneFromIdentity(const Sym3& c, Eigen::Vector3d* v) {
   if (!(err <= kTolerance)) return false;
   *v = out;
   return true;
-}
-
-/// R·C·Rᵀ for symmetric C.
-inline Eigen::Matrix3d rotateSymmetric(const Eigen::Matrix3d& R, const Eigen::Matrix3d& C) {
-  const Eigen::Matrix3d RC = R * C;
-  Eigen::Matrix3d out;
-  out(0, 0) = RC.row(0).dot(R.row(0));
-  out(0, 1) = RC.row(0).dot(R.row(1));
-  out(0, 2) = RC.row(0).dot(R.row(2));
-  out(1, 1) = RC.row(1).dot(R.row(1));
-  out(1, 2) = RC.row(1).dot(R.row(2));
-  out(2, 2) = RC.row(2).dot(R.row(2));
-  out(1, 0) = out(0, 1);
-  out(2, 0) = out(0, 2);
-  out(2, 1) = out(1, 2);
-  return out;
 }
 
 }  // namespace rigcal::registration::detail
