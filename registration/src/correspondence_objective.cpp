@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "gicp_batch.hpp"
 #include "kernels.hpp"
@@ -21,11 +22,13 @@ CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> p
   for (const auto& p : pairs) total += p.source->size();
   match_.assign(total, kNone);
   used_.assign(total, kNone);
+  used_next_.assign(total, kNone);
   second_.assign(total, kNone);
   query_.assign(total, Eigen::Vector3f::Zero());
   margin_.assign(total, -1.0F);
   if (kind == Residual::kGicp) {
     weight_.resize(total);
+    weight_next_.resize(total);
     source_cov_.reserve(total);
     for (const auto& p : pairs) {
       for (const auto& c : p.source->covariances) source_cov_.push_back(Sym3::upperOf(c));
@@ -139,19 +142,40 @@ bool CorrespondenceObjective::match(const Target& target, std::size_t g, const E
 }
 
 template <Residual K>
-LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) {
+double CorrespondenceObjective::costTerm(std::size_t g, const Eigen::Vector3d& r, const PointCloud& tc,
+                                         std::uint32_t j) const {
+  if constexpr (K == Residual::kPointToPlane) {
+    const double e = tc.normals[j].head<3>().dot(r);
+    return e * e;
+  } else if constexpr (K == Residual::kGicp) {
+    (void)tc, (void)j;
+    return r.dot(weight_[g].times(r));
+  } else {
+    (void)g, (void)tc, (void)j;
+    return r.squaredNorm();
+  }
+}
+
+template <Residual K, bool kPrevious>
+CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const PairChunk& chunk,
+                                                                      const Eigen::Matrix4d& M) {
   const PointCloud& source = *pairs_[chunk.pair].source;
   const Target& target = *pairs_[chunk.pair].target;
   const PointCloud& tc = target.cloud();
   const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();
-  LinearSystem sys;
+  Pass out;
+  LinearSystem& sys = out.sys;
   PointToPointSums p2p;
   GicpBatch gicp;
   for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
     const std::size_t g = chunk.offset + (i - chunk.begin);
     const Eigen::Vector4d q4 = M * source.points[i];
+    if constexpr (kPrevious) {  // exactly costChunk's term: the acceptance test sees the same number
+      const std::uint32_t previous = used_[g];
+      if (previous != kNone) out.previous_cost += costTerm<K>(g, (q4 - tc.points[previous]).head<3>(), tc, previous);
+    }
     std::uint32_t j = kNone;
-    used_[g] = kNone;
+    used_next_[g] = kNone;
     if (!match(target, g, q4, &j)) continue;
     const Eigen::Vector3d q = q4.head<3>();
     const Eigen::Vector3d r = q - tc.points[j].head<3>();
@@ -168,10 +192,10 @@ LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, con
     } else if constexpr (K == Residual::kGicp) {
       const Sym3 t = Sym3::load(target.covarianceUpperFloat().data() + 6 * std::size_t{j});
       if (source_axis_.empty()) {
-        gicp.add(q, r, fusedCovariance(R, source_cov_[g], t), Eigen::Vector3d::Zero(), &weight_[g]);
+        gicp.add(q, r, fusedCovariance(R, source_cov_[g], t), Eigen::Vector3d::Zero(), &weight_next_[g]);
       } else {  // C_s = I − v·vᵀ: R·C_s·Rᵀ = I − (R·v)(R·v)ᵀ
         const Sym3 base{t.xx + 1.0, t.xy, t.xz, t.yy + 1.0, t.yz, t.zz + 1.0};
-        gicp.add(q, r, base, R * source_axis_[g], &weight_[g]);
+        gicp.add(q, r, base, R * source_axis_[g], &weight_next_[g]);
       }
     } else {
       p2p.add(q);
@@ -179,14 +203,14 @@ LinearSystem CorrespondenceObjective::linearizeChunk(const PairChunk& chunk, con
       sys.b.tail<3>() += q.cross(r);
       sys.cost += d2;
     }
-    used_[g] = j;
+    used_next_[g] = j;
     ++sys.inliers;
     sys.sum_sq_distance += d2;
   }
   if constexpr (K == Residual::kPointToPoint) p2p.finish(sys.H);
   if constexpr (K == Residual::kGicp) gicp.finish(sys);
   mirrorUpper(sys.H);
-  return sys;
+  return out;
 }
 
 template <Residual K>
@@ -198,38 +222,48 @@ double CorrespondenceObjective::costChunk(const PairChunk& chunk, const Eigen::M
     const std::size_t g = chunk.offset + (i - chunk.begin);
     const std::uint32_t j = used_[g];  // the same matches as the linearisation: the cost is comparable
     if (j == kNone) continue;
-    const Eigen::Vector3d r = (M * source.points[i] - tc.points[j]).head<3>();
-    if constexpr (K == Residual::kPointToPlane) {
-      const double e = tc.normals[j].head<3>().dot(r);
-      cost += e * e;
-    } else if constexpr (K == Residual::kGicp) {
-      cost += r.dot(weight_[g].times(r));
-    } else {
-      cost += r.squaredNorm();
-    }
+    cost += costTerm<K>(g, (M * source.points[i] - tc.points[j]).head<3>(), tc, j);
   }
   return cost;
 }
 
-std::optional<LinearSystem> CorrespondenceObjective::linearize(const Pose& T, const Deadline& deadline) {
-  const Eigen::Matrix4d M = T.matrix();
+std::optional<CorrespondenceObjective::Pass> CorrespondenceObjective::pass(const Eigen::Matrix4d& M,
+                                                                              const Deadline& deadline,
+                                                                              bool previous_cost) {
   std::atomic<bool> stopped{false};
-  LinearSystem sys = parallelReduce(chunks_.size(), num_threads_, LinearSystem{}, [&](std::size_t t) {
+  Pass total = parallelReduce(chunks_.size(), num_threads_, Pass{}, [&](std::size_t t) {
     if (stopped.load(std::memory_order_relaxed) || deadline.expired()) {
       stopped.store(true, std::memory_order_relaxed);
-      return LinearSystem{};
+      return Pass{};
     }
+    const PairChunk& c = chunks_[t];
     switch (kind_) {
       case Residual::kPointToPlane:
-        return linearizeChunk<Residual::kPointToPlane>(chunks_[t], M);
+        return previous_cost ? linearizeChunk<Residual::kPointToPlane, true>(c, M)
+                             : linearizeChunk<Residual::kPointToPlane, false>(c, M);
       case Residual::kGicp:
-        return linearizeChunk<Residual::kGicp>(chunks_[t], M);
+        return previous_cost ? linearizeChunk<Residual::kGicp, true>(c, M) : linearizeChunk<Residual::kGicp, false>(c, M);
       case Residual::kPointToPoint:
         break;
     }
-    return linearizeChunk<Residual::kPointToPoint>(chunks_[t], M);
+    return previous_cost ? linearizeChunk<Residual::kPointToPoint, true>(c, M)
+                         : linearizeChunk<Residual::kPointToPoint, false>(c, M);
   });
   if (stopped.load()) return std::nullopt;
+  return total;
+}
+
+std::optional<LinearSystem> CorrespondenceObjective::linearize(const Pose& T, const Deadline& deadline) {
+  std::optional<LinearSystem> sys;
+  if (cached_ && cached_at_ == T.matrix()) {
+    sys = std::move(cached_);  // cost() matched and linearised here already
+  } else if (std::optional<Pass> p = pass(T.matrix(), deadline, false)) {
+    sys = p->sys;
+  }
+  cached_.reset();
+  if (!sys) return std::nullopt;
+  used_.swap(used_next_);  // this pass's matches and weights are what cost() compares against now
+  weight_.swap(weight_next_);
   return sys;
 }
 
@@ -260,8 +294,18 @@ std::optional<LinearSystem> CorrespondenceObjective::measure(const Pose& T, cons
   return sys;
 }
 
-std::optional<double> CorrespondenceObjective::cost(const Pose& T, const Deadline& deadline) {
+std::optional<double> CorrespondenceObjective::cost(const Pose& T, const Deadline& deadline, bool then_linearize) {
   const Eigen::Matrix4d M = T.matrix();
+  cached_.reset();
+  if (then_linearize) {
+    // The cost with the current matches comes almost free with the next pass's transform of every
+    // point: one pass instead of a cost pass and then a linearisation once the step is accepted.
+    std::optional<Pass> p = pass(M, deadline, true);
+    if (!p) return std::nullopt;
+    cached_ = p->sys;
+    cached_at_ = M;
+    return p->previous_cost;
+  }
   std::atomic<bool> stopped{false};
   const double total = parallelReduce(chunks_.size(), num_threads_, 0.0, [&](std::size_t t) {
     if (stopped.load(std::memory_order_relaxed) || deadline.expired()) {

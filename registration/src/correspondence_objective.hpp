@@ -2,6 +2,7 @@
 // Private: nearest-neighbour objectives (point-to-point, point-to-plane, GICP) over one or several
 // (source, target) pairs that share one pose.
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -18,15 +19,32 @@ class CorrespondenceObjective final : public Objective {
   CorrespondenceObjective(std::span<const SourceTarget> pairs, Residual kind, double max_distance, int num_threads);
 
   std::optional<LinearSystem> linearize(const Pose& T, const Deadline& deadline) override;
-  std::optional<double> cost(const Pose& T, const Deadline& deadline) override;
+  /// With `then_linearize`, one pass also linearises at T (matching there) and keeps that for linearize(T).
+  std::optional<double> cost(const Pose& T, const Deadline& deadline, bool then_linearize) override;
   /// Matches only, through the same cache: after convergence almost no point needs the tree.
   std::optional<LinearSystem> measure(const Pose& T, const Deadline& deadline) override;
 
  private:
-  template <Residual K>
-  LinearSystem linearizeChunk(const PairChunk& chunk, const Eigen::Matrix4d& M);
+  /// A linearisation's sums, and with kPrevious also the cost at the same pose with the previous
+  /// linearisation's matches (what cost() would return there).
+  struct Pass {
+    LinearSystem sys;
+    double previous_cost = 0.0;
+    Pass& operator+=(const Pass& o) {
+      sys += o.sys;
+      previous_cost += o.previous_cost;
+      return *this;
+    }
+  };
+  /// Matches and linearises at T into the *_next_ buffers (cost() still reads the current ones).
+  std::optional<Pass> pass(const Eigen::Matrix4d& M, const Deadline& deadline, bool previous_cost);
+  template <Residual K, bool kPrevious>
+  Pass linearizeChunk(const PairChunk& chunk, const Eigen::Matrix4d& M);
   template <Residual K>
   double costChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) const;
+  /// Source point g's cost term for residual r against target point j, with the current weights.
+  template <Residual K>
+  double costTerm(std::size_t g, const Eigen::Vector3d& r, const PointCloud& tc, std::uint32_t j) const;
 
   /// The nearest target point of source point g (global index) at q, reusing the last one when q has
   /// moved less than half the gap between the last nearest and second-nearest distances: then, by the
@@ -46,10 +64,14 @@ class CorrespondenceObjective final : public Objective {
   std::vector<PairChunk> chunks_;
   std::vector<std::uint32_t> match_;    // per source point (concatenated): target index or kNone
   std::vector<std::uint32_t> used_;     // the match if the last linearisation used it, else kNone
+  std::vector<std::uint32_t> used_next_;  // the same for a pass not yet accepted (swapped in by linearize)
   std::vector<std::uint32_t> second_;   // the second nearest at the last search (a search hint), or kNone
   std::vector<Eigen::Vector3f> query_;  // where the last tree search for it ran
   std::vector<float> margin_;           // how far it may move from there keeping the match (m)
   std::vector<Sym3> weight_;            // GICP: (C_t + R·C_s·Rᵀ)⁻¹ at the last linearisation
+  std::vector<Sym3> weight_next_;
+  std::optional<LinearSystem> cached_;  // a pass cost() ran at cached_at_, for linearize() there
+  Eigen::Matrix4d cached_at_ = Eigen::Matrix4d::Zero();
   std::vector<Sym3> source_cov_;        // GICP: the sources' covariances, compact, concatenated
   std::vector<Eigen::Vector3d> source_axis_;  // GICP: v with C_s = I − v·vᵀ, when every source has that form
 };

@@ -45,7 +45,7 @@ class NdtObjective final : public detail::Objective {
   }
   // NDT has no fixed matches, so the cost at a trial pose is a full pass anyway: linearise there too and
   // keep it, since an accepted trial pose is exactly where the next linearize() runs.
-  std::optional<double> cost(const Pose& T, const Deadline& deadline) override {
+  std::optional<double> cost(const Pose& T, const Deadline& deadline, bool /*then_linearize*/) override {
     cached_ = run(T, deadline);
     if (!cached_) return std::nullopt;
     cached_at_ = T.matrix();

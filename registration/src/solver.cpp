@@ -13,6 +13,11 @@ std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0) {
   return buf;
 }
 
+// The step is judged in the source frame, so a small rotation far from the target origin is small.
+bool isConverged(const Pose& step, const SolverParams& params) {
+  return step.translation().norm() < params.transformation_epsilon && rotationAngle(step) < params.rotation_epsilon;
+}
+
 Status stopStatus(const Deadline& deadline) {
   return deadline.check() == StopReason::kCancelled ? Status::kCancelled : Status::kTimeout;
 }
@@ -65,7 +70,7 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
         continue;
       }
       T_new = expSE3(delta) * out.T;  // left perturbation, see kernels.hpp
-      const std::optional<double> c = objective.cost(T_new, deadline);
+      const std::optional<double> c = objective.cost(T_new, deadline, !isConverged(out.T.inverse() * T_new, params));
       if (!c) {
         out.status = stopStatus(deadline);
         out.T = out.T_linearized;
@@ -85,10 +90,9 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
       out.status = Status::kConverged;
       return out;
     }
-    // Judge the step in the source frame, so a small rotation far from the target origin is small.
     const Pose step = out.T.inverse() * T_new;
     out.T = T_new;
-    if (step.translation().norm() < params.transformation_epsilon && rotationAngle(step) < params.rotation_epsilon) {
+    if (isConverged(step, params)) {
       out.converged = true;
       out.status = Status::kConverged;
       return out;

@@ -45,8 +45,10 @@ class Objective {
   virtual ~Objective() = default;
   /// Matches and linearises at T; nullopt when the deadline stopped it part-way.
   virtual std::optional<LinearSystem> linearize(const Pose& T, const Deadline& deadline) = 0;
-  /// The cost at T with the matches of the last linearize(); nullopt on deadline.
-  virtual std::optional<double> cost(const Pose& T, const Deadline& deadline) = 0;
+  /// The cost at T with the matches of the last linearize(); nullopt on deadline. `then_linearize`: the
+  /// solver will call linearize(T) next if this cost is accepted, so an objective may do both in one pass
+  /// and keep the linearisation for then (false for a converging last step, where nothing follows).
+  virtual std::optional<double> cost(const Pose& T, const Deadline& deadline, bool then_linearize) = 0;
   /// True when linearize()'s inliers / sum_sq_distance are nearest-neighbour metrics within the
   /// method's max distance, so they can stand in for an evaluation.
   [[nodiscard]] virtual bool reportsNeighborMetrics() const { return true; }
