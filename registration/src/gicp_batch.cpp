@@ -7,9 +7,9 @@ namespace rigcal::registration::detail {
 
 namespace {
 
-// kLanes doubles: one AVX register in the AVX2 clone, two SSE2 registers in the baseline one; operators
+// kLanes doubles: one AVX register in the AVX2 build, two SSE2 registers in the baseline one; operators
 // work lane by lane. Read in place from the (8-byte aligned) columns, by reference: passing a 32-byte
-// vector by value would differ between the two clones' ABIs.
+// vector by value would differ between the two builds' ABIs.
 constexpr std::size_t kLanes = 4;
 using Lanes = double __attribute__((vector_size(8 * kLanes), aligned(8), may_alias));
 const Lanes& lanes(const double* p) { return *reinterpret_cast<const Lanes*>(p); }
@@ -18,8 +18,7 @@ const Lanes& lanes(const double* p) { return *reinterpret_cast<const Lanes*>(p);
 constexpr int upper(int r, int c) { return r * 6 - r * (r - 1) / 2 + (c - r); }
 constexpr int kB = 21, kCost = 27;
 
-// The batch's arithmetic, cloned for AVX2 and the baseline and picked once at load time. A file-local
-// function of plain pointers: a member or a vector argument would need the clones visible everywhere.
+// The batch's columns, as plain pointers for the file-local arithmetic below.
 struct Columns {
   const double (*q)[GicpBatch::kCapacity];
   const double (*r)[GicpBatch::kCapacity];
@@ -30,7 +29,10 @@ struct Columns {
   std::size_t n;
 };
 
-__attribute__((target_clones("avx2", "default"))) void accumulate(const Columns& c, double (*sums)[kLanes]) {
+// The arithmetic, written once and compiled twice: for x86-64's baseline and for AVX2 (inlined into a
+// target("avx2") function). Dispatched by hand, once, rather than by an ifunc (target_clones), whose
+// resolver runs before the sanitizers' runtimes are up.
+[[gnu::always_inline]] inline void accumulateLanes(const Columns& c, double (*sums)[kLanes]) {
   Lanes s[28];
   for (int k = 0; k < 28; ++k) s[k] = lanes(sums[k]);
   for (std::size_t i = 0; i < c.n; i += kLanes) {
@@ -86,7 +88,22 @@ __attribute__((target_clones("avx2", "default"))) void accumulate(const Columns&
   for (int k = 0; k < 28; ++k) __builtin_memcpy(sums[k], &s[k], sizeof s[k]);
 }
 
+void accumulateBaseline(const Columns& c, double (*sums)[kLanes]) { accumulateLanes(c, sums); }
+[[gnu::target("avx2")]] void accumulateAvx2(const Columns& c, double (*sums)[kLanes]) { accumulateLanes(c, sums); }
+
+bool cpuHasAvx2() {
+  static const bool avx2 = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
+  return avx2;
+}
+
 }  // namespace
+
+bool GicpBatch::avx2Available() { return cpuHasAvx2(); }
+
+GicpBatch::GicpBatch(GicpLanes lanes) : avx2_(lanes != GicpLanes::kBaseline && cpuHasAvx2()) {}
 
 void GicpBatch::run() {
   while (n_ % kLanes != 0) {  // pad to whole lanes with matches that contribute nothing
@@ -96,7 +113,12 @@ void GicpBatch::run() {
     mask_[i] = 0.0;
     out_[i] = &discard_;
   }
-  accumulate({q_, r_, a_, base_, mask_, out_, n_}, sums_);
+  const Columns columns{q_, r_, a_, base_, mask_, out_, n_};
+  if (avx2_) {
+    accumulateAvx2(columns, sums_);
+  } else {
+    accumulateBaseline(columns, sums_);
+  }
   n_ = 0;
 }
 

@@ -2,9 +2,9 @@
 // Private: GICP's per-match arithmetic (fused covariance, its inverse, the Gauss–Newton blocks) for a
 // batch of matches at a time, four matches per instruction. The matching loop is branchy and scalar; this
 // part is ~170 flops per match with no branches, so it is gathered into columns and run in four lanes:
-// AVX2 where the CPU has it, else x86-64's baseline SSE2 (two instructions per step), chosen at load time
-// (target_clones). Both clones do the same IEEE operations in the same order (no FMA contraction), so
-// results do not depend on the CPU, nor on the thread count (batches never cross the solver's chunks).
+// AVX2 where the CPU has it, else x86-64's baseline SSE2 (two instructions per step), chosen once at run
+// time. Both do the same IEEE operations in the same order (no FMA contraction), so results do not
+// depend on the CPU, nor on the thread count (batches never cross the solver's chunks).
 #include <cstddef>
 
 #include <Eigen/Core>
@@ -14,8 +14,15 @@
 
 namespace rigcal::registration::detail {
 
+/// Which build of the arithmetic a batch runs: the best the CPU has, or the baseline (tests compare them).
+enum class GicpLanes { kBest, kBaseline };
+
 class GicpBatch {
  public:
+  explicit GicpBatch(GicpLanes lanes = GicpLanes::kBest);
+  /// Whether kBest is the AVX2 build on this CPU (else it is the baseline).
+  static bool avx2Available();
+
   static constexpr std::size_t kCapacity = 32;  // matches per run: a multiple of the 4 lanes
 
   /// One match: q = T·p in the target frame, r = q − t, and its fused covariance C = base − a·aᵀ
@@ -47,6 +54,7 @@ class GicpBatch {
   alignas(32) double mask_[kCapacity];  // 0 for the padding of a partial lane group
   Sym3* out_[kCapacity];
   Sym3 discard_;  // the padding's weight
+  bool avx2_ = false;  // which build of the arithmetic run() uses
   std::size_t n_ = 0;
   // H's 21 upper entries (row-major), b's 6, the cost: four lanes each.
   alignas(32) double sums_[28][4] = {};

@@ -34,7 +34,18 @@ std::vector<Match> randomMatches(std::size_t n, bool rank_one, unsigned seed) {
 
 Sym3 upper(const Eigen::Matrix3d& m) { return {m(0, 0), m(0, 1), m(0, 2), m(1, 1), m(1, 2), m(2, 2)}; }
 
-void expectMatchesFormula(const std::vector<Match>& matches) {
+LinearSystem run(const std::vector<Match>& matches, GicpLanes lanes, std::vector<Sym3>* weights) {
+  LinearSystem sys;
+  GicpBatch batch(lanes);
+  weights->assign(matches.size(), Sym3{});
+  for (std::size_t i = 0; i < matches.size(); ++i) {
+    batch.add(matches[i].q, matches[i].r, upper(matches[i].base), matches[i].a, &(*weights)[i]);
+  }
+  batch.finish(sys);
+  return sys;
+}
+
+void expectMatchesFormula(const std::vector<Match>& matches, GicpLanes lanes) {
   LinearSystem expected;
   for (const Match& m : matches) {
     const Eigen::Matrix3d W = (m.base - m.a * m.a.transpose()).inverse();
@@ -44,13 +55,8 @@ void expectMatchesFormula(const std::vector<Match>& matches) {
     expected.b += J.transpose() * W * m.r;
     expected.cost += m.r.dot(W * m.r);
   }
-  LinearSystem got;
-  GicpBatch batch;
-  std::vector<Sym3> weights(matches.size());
-  for (std::size_t i = 0; i < matches.size(); ++i) {
-    batch.add(matches[i].q, matches[i].r, upper(matches[i].base), matches[i].a, &weights[i]);
-  }
-  batch.finish(got);
+  std::vector<Sym3> weights;
+  LinearSystem got = run(matches, lanes, &weights);
   got.H.triangularView<Eigen::StrictlyLower>() = got.H.transpose();
   const double scale = expected.H.cwiseAbs().maxCoeff();
   EXPECT_LT((got.H - expected.H).cwiseAbs().maxCoeff(), 1e-12 * scale);
@@ -67,9 +73,32 @@ void expectMatchesFormula(const std::vector<Match>& matches) {
 }
 
 // 77 = two full batches of 32 plus 13, which pads the last lanes: every path of the batch.
-TEST(GicpBatch, RankOneSourcesMatchTheFormula) { expectMatchesFormula(randomMatches(77, true, 1)); }
-TEST(GicpBatch, GeneralSourcesMatchTheFormula) { expectMatchesFormula(randomMatches(77, false, 2)); }
-TEST(GicpBatch, FewerMatchesThanOneLaneGroup) { expectMatchesFormula(randomMatches(3, true, 3)); }
+TEST(GicpBatch, RankOneSourcesMatchTheFormula) {
+  for (GicpLanes lanes : {GicpLanes::kBest, GicpLanes::kBaseline}) expectMatchesFormula(randomMatches(77, true, 1), lanes);
+}
+TEST(GicpBatch, GeneralSourcesMatchTheFormula) {
+  for (GicpLanes lanes : {GicpLanes::kBest, GicpLanes::kBaseline}) expectMatchesFormula(randomMatches(77, false, 2), lanes);
+}
+TEST(GicpBatch, FewerMatchesThanOneLaneGroup) {
+  for (GicpLanes lanes : {GicpLanes::kBest, GicpLanes::kBaseline}) expectMatchesFormula(randomMatches(3, true, 3), lanes);
+}
+
+// A registration must not depend on the CPU it runs on: the AVX2 and the baseline builds give the same
+// bits (same operations in the same order, no fused multiply-add).
+TEST(GicpBatch, Avx2AndBaselineGiveIdenticalBits) {
+  if (!GicpBatch::avx2Available()) GTEST_SKIP() << "this CPU has no AVX2: only the baseline runs here";
+  const std::vector<Match> m = randomMatches(77, true, 5);
+  std::vector<Sym3> wa, wb;
+  const LinearSystem a = run(m, GicpLanes::kBest, &wa), b = run(m, GicpLanes::kBaseline, &wb);
+  EXPECT_EQ(a.H, b.H);
+  EXPECT_EQ(a.b, b.b);
+  EXPECT_EQ(a.cost, b.cost);
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    EXPECT_EQ(wa[i].xx, wb[i].xx);
+    EXPECT_EQ(wa[i].xy, wb[i].xy);
+    EXPECT_EQ(wa[i].zz, wb[i].zz);
+  }
+}
 
 TEST(GicpBatch, FinishStartsAFreshSum) {
   const std::vector<Match> m = randomMatches(40, true, 4);
