@@ -146,7 +146,9 @@ TEST_F(LidarLidarWorkerSim, ATinyDeadlineGivesEachLidarAResultOrADeadlineFailure
     expectResultOrDeadline(r);
     EXPECT_TRUE(r.deadline_reached) << r.calibration_sensor;
   }
-  EXPECT_LT(worker.seconds, 0.1 + 0.15) << "bounded overshoot: a step that does not fit is not started";
+  // Bounded overshoot: a step that does not fit is not started, but each lidar first crops its first
+  // frame's source and target cloud to learn the target's size (0.08 s each here, quiet machine).
+  EXPECT_LT(worker.seconds, 0.1 + 2 * 0.2) << "bounded overshoot";
 }
 
 // The worker's thread hand-over (also under ASan and TSan): datasets added from another thread while one
