@@ -1,30 +1,64 @@
 #include "rigcal/calib/calibration_scheduler.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace rigcal::calib {
+namespace {
+
+CalibrationBudget::Clock::duration toDuration(double seconds) {
+  return std::chrono::duration_cast<CalibrationBudget::Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+}  // namespace
+
+CalibrationBudget::CalibrationBudget(double deadline_s, std::size_t runs, const registration::CancelToken* cancel)
+    : total_s_(deadline_s),
+      limited_(std::isfinite(deadline_s) && deadline_s > 0),
+      remaining_runs_(std::max<std::size_t>(runs, 1)),
+      cancel_(cancel) {}
 
 CalibrationBudget::CalibrationBudget(Clock::time_point start, double deadline_s, std::size_t runs,
                                      const registration::CancelToken* cancel)
-    : end_(Clock::time_point::max()),
-      remaining_runs_(runs == 0 ? 1 : runs),
-      limited_(std::isfinite(deadline_s) && deadline_s > 0),
-      cancel_(cancel) {
-  if (limited_)
-    end_ = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(deadline_s));
+    : CalibrationBudget(deadline_s, runs, cancel) {
+  started_ = true;
+  if (limited_) end_ = start + toDuration(deadline_s);
 }
 
 registration::Deadline CalibrationBudget::next() {
-  if (!limited_) return registration::Deadline::never(cancel_);
   const auto now = Clock::now();
+  if (!started_) {
+    started_ = true;
+    if (limited_) end_ = now + toDuration(total_s_);
+  } else if (paused_ && limited_) {
+    end_ += now - paused_at_;  // the wait for this lidar's dataset was not calibration time
+  }
+  paused_ = false;
+  if (!limited_) return registration::Deadline::never(cancel_);
   const std::size_t share = remaining_runs_;
   if (remaining_runs_ > 1) --remaining_runs_;
   if (now >= end_) return registration::Deadline::at(end_, cancel_);
   return registration::Deadline::at(now + (end_ - now) / static_cast<long>(share), cancel_);
 }
 
+void CalibrationBudget::pause() {
+  if (!started_ || paused_) return;
+  paused_ = true;
+  paused_at_ = Clock::now();
+}
+
+void CalibrationBudget::expectRuns(std::size_t runs) { remaining_runs_ = std::max<std::size_t>(runs, 1); }
+
 registration::Deadline CalibrationBudget::overall() const {
-  return limited_ ? registration::Deadline::at(end_, cancel_) : registration::Deadline::never(cancel_);
+  if (!limited_) return registration::Deadline::never(cancel_);
+  if (!started_) return registration::Deadline::at(Clock::now() + toDuration(total_s_), cancel_);
+  return registration::Deadline::at(paused_ ? end_ + (Clock::now() - paused_at_) : end_, cancel_);
+}
+
+double CalibrationBudget::spentSeconds() const {
+  if (!started_ || !limited_) return 0.0;
+  const auto now = paused_ ? paused_at_ : Clock::now();
+  return total_s_ - std::chrono::duration<double>(end_ - now).count();
 }
 
 double secondsLeft(const registration::Deadline& deadline) {

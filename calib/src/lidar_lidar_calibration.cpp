@@ -1,6 +1,9 @@
 #include "rigcal/calib/lidar_lidar_calibration.hpp"
 
+#include <algorithm>
 #include <exception>
+#include <iomanip>
+#include <sstream>
 
 #include "lidar_lidar_calibrator.hpp"
 #include "rigcal/calib/calibration_scheduler.hpp"
@@ -19,6 +22,8 @@ LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset
   out.calibration_sensor = dataset.calibration_sensor;
   out.T_mapping_calib_guess = dataset.T_mapping_calib_guess;
   out.T_mapping_calib = finitePose(dataset.T_mapping_calib_guess) ? dataset.T_mapping_calib_guess : Pose::Identity();
+  if (deadline.when() != registration::Deadline::Clock::time_point::max())
+    out.deadline_share_s = std::max(0.0, secondsLeft(deadline));
   out.failure = validateDataset(dataset, params);
   if (out.failure.empty()) {
     try {
@@ -30,6 +35,12 @@ LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset
     }
   }
   out.seconds = since(t0);
+  if (!out.ok && out.deadline_reached && out.deadline_share_s >= 0) {  // say that time, not data, was short
+    std::ostringstream msg;
+    msg << "deadline: its share of calibration_deadline_s was " << std::fixed << std::setprecision(2)
+        << out.deadline_share_s << " s; " << out.failure;
+    out.failure = msg.str();
+  }
   return out;
 }
 

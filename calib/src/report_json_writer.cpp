@@ -69,7 +69,8 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
   j["calibrated"] = true;
   j["ok"] = r->ok;
   if (!r->ok) j["failure"] = r->failure;
-  j["deadline_reached"] = r->deadline_reached;
+  j["deadline_reached"] = r->deadline_reached;  // this lidar ran out of time (its result is the best so far)
+  if (r->deadline_share_s >= 0) j["deadline_share_s"] = r->deadline_share_s;
   j["result"] = xyzRpy(r->T_mapping_calib);
   const Pose change = r->T_mapping_calib_guess.inverse() * r->T_mapping_calib;
   j["change_from_initial"] = {{"translation_m", change.translation().norm()},

@@ -49,8 +49,15 @@ std::string summaryTable(const CalibrationOutcome& o) {
     out << row(pair, result, r->ok ? r->T_mapping_calib : r->T_mapping_calib_guess, r->T_mapping_calib_guess, score,
                std::to_string(r->frames_used.size()) + "/" + std::to_string(d.frames.size()));
   }
-  for (const auto& r : o.lidars)
+  for (const auto& r : o.lidars) {
     if (!r.ok) out << "  " << r.calibration_sensor << ": " << r.failure << "\n";
+    else if (r.deadline_reached && r.deadline_share_s >= 0) {
+      char line[160];
+      std::snprintf(line, sizeof line, "  %s: ran out of time (its share %.1f s of the %.0f s deadline); best result so far\n",
+                    r.calibration_sensor.c_str(), r.deadline_share_s, o.deadline_s);
+      out << line;
+    }
+  }
   if (o.base && !o.base->ok) out << "  " << o.mapping_sensor << " (base): " << o.base->failure << "\n";
   out << "  ok (dl) = best result when the deadline (" << o.deadline_s << " s) was reached; dt, dr = change from the initial guess\n";
   return out.str();

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "../apps/run_command.hpp"
+#include "calibrate_chain.hpp"
 #include "sanitizers.hpp"
 #include "test_data.hpp"
 
@@ -115,11 +115,6 @@ int selectedOf(const std::string& text, const std::string& sensor) {
   return std::stoi(m[1]);
 }
 
-nlohmann::json readJson(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
-
 // A real VLP-16 capture as the mapping lidar; the calibration lidar `left` sends nothing. Replayed at
 // the recorded rate, Ctrl-C after the first progress lines: the display counted scans, and the run ends
 // at once with the shortfall named, a partial report and exit 130.
@@ -180,7 +175,7 @@ TEST(CalibrateInteractive, NoProgressLineWhenNotATerminal) {
 TEST(CalibrateInteractive, CtrlCWithEnoughFramesCalibratesWhatItHas) {
   if (RIGCAL_SANITIZED) GTEST_SKIP() << "a real-time replay of a simulated drive: Release only";
   TempDir sim, out;
-  std::ofstream(sim / "drive.yaml") << R"(scenario: ctrl-c
+  ASSERT_NO_FATAL_FAILURE(simulateYaml(R"(scenario: ctrl-c
 seed: 5
 start_time: 1700000000.0
 rig:
@@ -202,11 +197,9 @@ trajectory:
     - {type: accelerate, to_kmh: 5, duration: 2.0}
     - {type: cruise, duration: 12.0}
 perturbation: {translation_m: 0.3, rotation_deg: 5.0}
-)";
-  const auto simulated = runRigcal({"sim", "--scenario", (sim / "drive.yaml").string(), "--out", sim.path().string()});
-  ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
-  TerminalRun run({"calibrate", "--config", (sim / "rig.yaml").string(), "--pcap", (sim / "recording.pcap").string(),
-                   "--rate", "1", "--deadline", "3", "--out", out.path().string()});
+)",
+                                       sim.path()));
+  TerminalRun run(calibrateArgs(sim.path(), out.path(), {"--rate", "1", "--deadline", "3"}));
   ASSERT_TRUE(run.started());
   const bool enough = run.readUntil([](const std::string& t) { return selectedOf(t, "front_left") >= 2; },
                                     std::chrono::seconds(30));

@@ -1,19 +1,17 @@
 // `rigcal calibrate --config RIG (--pcap F [--rate R] | --live | --shm) [--out DIR] [--deadline S] [--realtime]
 // [--stats FILE.json] [--pin] [--cores 0,1]`: the main job (input, pinning and stats options as `rigcal map`).
 // Mapping starts at once; each calibration lidar is calibrated (on its own thread, while mapping goes on) as
-// soon as its frame budget is full, the others at the end of input; then base-lidar calibration, the outputs
+// soon as its frame budget is full, the others at the end of input, all within one calibration_deadline_s
+// of calibration time (calib::LidarLidarWorker); then base-lidar calibration, the outputs
 // in --out, and a summary table. Ctrl-C ends the input early and calibrates what has enough
 // frames; a lidar without enough frames is named with what is missing (exit 5, partial report).
 #include <unistd.h>
 
 #include <chrono>
-#include <condition_variable>
 #include <cstdio>
-#include <deque>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <mutex>
 #include <sstream>
 #include <thread>
 
@@ -24,10 +22,10 @@
 #include "rigcal/calib/base_lidar_calibration.hpp"
 #include "rigcal/calib/base_lidar_multi.hpp"
 #include "rigcal/calib/calibration_outcome.hpp"
-#include "rigcal/calib/calibration_scheduler.hpp"
 #include "rigcal/calib/calibration_yaml_writer.hpp"
 #include "rigcal/calib/cloud_writers.hpp"
 #include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar_worker.hpp"
 #include "rigcal/calib/overview_png_writer.hpp"
 #include "rigcal/calib/report_json_writer.hpp"
 #include "rigcal/calib/summary_table.hpp"
@@ -55,65 +53,6 @@ std::string progressLine(const pipeline::PipelineProgress& p) {
   return o.str();
 }
 
-/// Calibrates the datasets the pipeline hands over, on its own thread, while mapping goes on. Datasets
-/// that arrive together share one calibration_deadline_s (CalibrationBudget).
-class CalibrationWorker {
- public:
-  explicit CalibrationWorker(const config::Parameters& params) : params_(params), thread_([this] { loop(); }) {}
-  ~CalibrationWorker() { finish(); }
-  CalibrationWorker(const CalibrationWorker&) = delete;
-  CalibrationWorker& operator=(const CalibrationWorker&) = delete;
-
-  void add(std::shared_ptr<const pipeline::CalibrationDataset> d) {
-    {
-      const std::lock_guard lock(mutex_);
-      pending_.push_back(std::move(d));
-    }
-    wake_.notify_one();
-  }
-  /// Waits until every dataset handed over is calibrated.
-  void finish() {
-    {
-      const std::lock_guard lock(mutex_);
-      done_ = true;
-    }
-    wake_.notify_one();
-    if (thread_.joinable()) thread_.join();
-  }
-  /// After finish().
-  std::vector<pipeline::CalibrationDataset> datasets;
-  std::vector<calib::LidarLidarResult> results;
-  double seconds = 0.0;
-
- private:
-  void loop() {
-    for (;;) {
-      std::vector<std::shared_ptr<const pipeline::CalibrationDataset>> batch;
-      {
-        std::unique_lock lock(mutex_);
-        wake_.wait(lock, [&] { return done_ || !pending_.empty(); });
-        if (pending_.empty()) return;
-        batch.assign(pending_.begin(), pending_.end());
-        pending_.clear();
-      }
-      const auto t0 = Clock::now();
-      calib::CalibrationBudget budget(t0, params_.calibration_deadline_s, batch.size());
-      for (const auto& d : batch) {
-        results.push_back(calib::calibrateLidarLidar(*d, params_, budget.next()));
-        datasets.push_back(*d);
-      }
-      seconds += since(t0);
-    }
-  }
-
-  config::Parameters params_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::deque<std::shared_ptr<const pipeline::CalibrationDataset>> pending_;
-  bool done_ = false;
-  std::thread thread_;
-};
-
 void run(const CalibrateOptions& o) {
   const auto t_start = Clock::now();
   config::RigConfig rig;
@@ -130,7 +69,9 @@ void run(const CalibrateOptions& o) {
   if (ec) throw CommandFailed(kExitInput, o.out + ": cannot create the output folder (" + ec.message() + ")");
 
   StopSignals signals;
-  CalibrationWorker worker(rig.parameters);
+  // Every calibration lidar shares one calibration_deadline_s, whenever its dataset comes (budget full
+  // during the drive, or end of input).
+  calib::LidarLidarWorker worker(rig.parameters, rig.roles.calibration_lidars.size());
   std::unique_ptr<pipeline::Pipeline> pipe;
   try {
     pipe = std::make_unique<pipeline::Pipeline>(rig, po, [&](std::shared_ptr<const pipeline::CalibrationDataset> d) {

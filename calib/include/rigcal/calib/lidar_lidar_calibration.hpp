@@ -45,6 +45,7 @@ struct LidarLidarResult {
   bool ok = false;               // the result beats the initial guess's score
   std::string failure;           // one line when !ok
   bool deadline_reached = false; // stopped by the deadline (or a cancel): the best so far
+  double deadline_share_s = -1.0; // seconds it was given when it started (its share); −1 = no limit
   Pose T_mapping_calib_guess = Pose::Identity();
   Pose T_mapping_calib = Pose::Identity();  // the best found (the guess when nothing beat it)
   CalibrationScore initial_score;
@@ -60,7 +61,8 @@ struct LidarLidarResult {
 /// Empty when `dataset` can be calibrated, else one line naming the field that is wrong.
 std::string validateDataset(const pipeline::CalibrationDataset& dataset, const config::Parameters& params);
 
-/// Never throws for bad data: an invalid dataset gives ok = false with the reason. Stops by `deadline`.
+/// Never throws for bad data: an invalid dataset gives ok = false with the reason. Stops by `deadline`;
+/// a failure because it ran out of time starts with "deadline:".
 LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
                                      const registration::Deadline& deadline, const LidarLidarOptions& options = {});
 

@@ -1,0 +1,58 @@
+#pragma once
+// Calibrates the datasets the pipeline hands over — one per calibration lidar, as soon as its frame
+// budget is full, the others at the end of input — on its own thread while mapping goes on. Every lidar
+// of the rig shares one calibration_deadline_s (CalibrationBudget): a lidar whose dataset comes early
+// gets its fair share of the whole (deadline / number of calibration lidars, plus whatever the lidars
+// before it left), not the whole deadline; the clock is paused while the worker waits for a dataset, and
+// at the end of input the lidars still pending share all that is left.
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/lidar_lidar_calibration.hpp"
+
+namespace rigcal::calib {
+
+class LidarLidarWorker {
+ public:
+  /// `calibration_lidars`: how many datasets may come (the rig's calibration lidars).
+  LidarLidarWorker(const config::Parameters& params, std::size_t calibration_lidars,
+                   const LidarLidarOptions& options = {}, const registration::CancelToken* cancel = nullptr);
+  ~LidarLidarWorker();  // finish()
+  LidarLidarWorker(const LidarLidarWorker&) = delete;
+  LidarLidarWorker& operator=(const LidarLidarWorker&) = delete;
+
+  /// Queues one lidar's dataset (any thread; returns at once).
+  void add(std::shared_ptr<const pipeline::CalibrationDataset> dataset);
+  /// No more datasets will come: the pending ones share what is left. Waits until all are calibrated.
+  void finish();
+  /// Datasets whose calibration has started / is done so far (any thread).
+  [[nodiscard]] std::size_t started() const;
+  [[nodiscard]] std::size_t completed() const;
+
+  /// After finish(): the datasets in the order they were calibrated, their results, and the calibration
+  /// seconds spent (waits for datasets excluded: what calibration_deadline_s bounds).
+  std::vector<pipeline::CalibrationDataset> datasets;
+  std::vector<LidarLidarResult> results;
+  double seconds = 0.0;
+
+ private:
+  void loop();
+
+  config::Parameters params_;
+  LidarLidarOptions options_;
+  CalibrationBudget budget_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::shared_ptr<const pipeline::CalibrationDataset>> pending_;
+  bool input_done_ = false;
+  std::size_t started_ = 0, completed_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace rigcal::calib

@@ -1,0 +1,67 @@
+#include "rigcal/calib/lidar_lidar_worker.hpp"
+
+#include <chrono>
+
+namespace rigcal::calib {
+
+LidarLidarWorker::LidarLidarWorker(const config::Parameters& params, std::size_t calibration_lidars,
+                                   const LidarLidarOptions& options, const registration::CancelToken* cancel)
+    : params_(params),
+      options_(options),
+      budget_(params.calibration_deadline_s, calibration_lidars, cancel),
+      thread_([this] { loop(); }) {}
+
+LidarLidarWorker::~LidarLidarWorker() { finish(); }
+
+void LidarLidarWorker::add(std::shared_ptr<const pipeline::CalibrationDataset> dataset) {
+  {
+    const std::lock_guard lock(mutex_);
+    pending_.push_back(std::move(dataset));
+  }
+  wake_.notify_one();
+}
+
+void LidarLidarWorker::finish() {
+  {
+    const std::lock_guard lock(mutex_);
+    input_done_ = true;
+  }
+  wake_.notify_one();
+  if (thread_.joinable()) thread_.join();
+}
+
+std::size_t LidarLidarWorker::started() const {
+  const std::lock_guard lock(mutex_);
+  return started_;
+}
+
+std::size_t LidarLidarWorker::completed() const {
+  const std::lock_guard lock(mutex_);
+  return completed_;
+}
+
+void LidarLidarWorker::loop() {
+  for (;;) {
+    std::shared_ptr<const pipeline::CalibrationDataset> dataset;
+    {
+      std::unique_lock lock(mutex_);
+      if (pending_.empty()) budget_.pause();  // waiting for a dataset is not calibration time
+      wake_.wait(lock, [&] { return input_done_ || !pending_.empty(); });
+      if (pending_.empty()) return;
+      // After the end of input no other lidar will come: the pending ones share all that is left.
+      if (input_done_) budget_.expectRuns(pending_.size());
+      dataset = std::move(pending_.front());
+      pending_.pop_front();
+      ++started_;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    LidarLidarResult result = calibrateLidarLidar(*dataset, params_, budget_.next(), options_);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    results.push_back(std::move(result));
+    datasets.push_back(*dataset);
+    const std::lock_guard lock(mutex_);
+    ++completed_;
+  }
+}
+
+}  // namespace rigcal::calib
