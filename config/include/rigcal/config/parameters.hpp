@@ -62,7 +62,8 @@ struct Parameters {
   double max_corr_dist_ultra_fine = 0.05;
   int lidar_calibration_min_frames = 2;
   int lidar_calibration_max_frames = 10;
-  double calibration_deadline_s = 10.0;  // rigcal: wall-clock bound of one calibration run
+  // rigcal: bounds the whole lidar-lidar calibration's running time, shared by the calibration lidars (README).
+  double calibration_deadline_s = 10.0;
 
   // Base-lidar calibration
   bool calibrate_base_frame = false;
