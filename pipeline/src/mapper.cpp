@@ -93,12 +93,13 @@ struct Mapper::Impl {
   }
 
   static std::shared_ptr<const reg::Target> buildTarget(const std::vector<KeyframeCloud>& clouds,
-                                                        const config::Parameters& params, bool use_ndt) {
+                                                        const config::Parameters& params, bool use_ndt,
+                                                        int threads) {
     reg::PointCloud merged;
     for (const auto& k : clouds) merged.points.insert(merged.points.end(), k->points.begin(), k->points.end());
     merged = reg::voxelDownsample(merged, params.leaf_size_local_map);
     reg::TargetOptions o;
-    o.num_threads = std::max(1, params.mapper_num_threads);
+    o.num_threads = threads;
     if (use_ndt) o.ndt_resolutions = {params.mapper_resolution};
     else o.normals_and_covariances = true;
     return std::make_shared<const reg::Target>(std::move(merged), o);
@@ -146,11 +147,15 @@ struct Mapper::Impl {
     std::vector<KeyframeCloud> clouds(local.begin(), local.end());
     scans_since_launch = 0;
     rebuild_wanted = false;
-    pending_target = std::async(std::launch::async, [clouds = std::move(clouds), p = params, ndt = use_ndt] {
+    // Real time: one build thread, so the registering threads keep one core to themselves (a build on
+    // both cores slows both halves of every registration's parallel loop). Offline: as fast as possible.
+    // The Target is the same whatever the thread count.
+    const int threads = deterministic ? std::max(1, params.mapper_num_threads) : 1;
+    pending_target = std::async(std::launch::async, [clouds = std::move(clouds), p = params, ndt = use_ndt, threads] {
       // Below the registering thread: a build (~5x one registration's CPU) must not stretch the scans
       // that register meanwhile, on two cores. Its helper threads inherit the niceness.
       ::setpriority(PRIO_PROCESS, id_t(::gettid()), kBuildNiceness);
-      return buildTarget(clouds, p, ndt);
+      return buildTarget(clouds, p, ndt, threads);
     });
   }
 
