@@ -14,6 +14,40 @@ namespace rigcal::registration {
 
 namespace {
 
+// Unit eigenvector of the smallest eigenvalue of a symmetric 3x3 matrix. Only that one is needed, so
+// instead of a full decomposition (Eigen's computeDirect: ~1.1k instructions, a third of them atan2 and
+// sincos) the eigenvalues come from the trigonometric closed form and the vector from the largest cross
+// product of two rows of (C − λ_min·I). Where the two smallest eigenvalues nearly coincide (a line, a
+// blob: the normal is ill-defined and the cross products lose precision) Eigen's solver decides, as before.
+Eigen::Vector3d smallestEigenvector(const Eigen::Matrix3d& c) {
+  const double mean = c.trace() / 3.0;
+  Eigen::Matrix3d b = c;
+  b.diagonal().array() -= mean;
+  const double p = std::sqrt(b.squaredNorm() / 6.0);
+  if (p > 1e-150 * std::max(1.0, std::abs(mean))) {
+    const double half_det = (b / p).determinant() / 2.0;
+    // φ in [0, π/3]; cos(φ + 2π/3) = −cos φ / 2 − sin φ·√3/2 spares a second cosine.
+    const double cos_phi = std::cos(std::acos(std::clamp(half_det, -1.0, 1.0)) / 3.0);
+    const double sin_phi = std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi));
+    const double largest = mean + 2.0 * p * cos_phi;
+    const double smallest = mean - p * (cos_phi + 1.7320508075688772935 * sin_phi);
+    const double middle = 3.0 * mean - largest - smallest;
+    if (middle - smallest > 1e-3 * (largest - smallest)) {
+      Eigen::Matrix3d m = c;
+      m.diagonal().array() -= smallest;
+      const Eigen::Vector3d c01 = m.row(0).cross(m.row(1)), c02 = m.row(0).cross(m.row(2)),
+                            c12 = m.row(1).cross(m.row(2));
+      const double n01 = c01.squaredNorm(), n02 = c02.squaredNorm(), n12 = c12.squaredNorm();
+      const Eigen::Vector3d& best = n01 >= n02 ? (n01 >= n12 ? c01 : c12) : (n02 >= n12 ? c02 : c12);
+      const double best_norm = std::max({n01, n02, n12});
+      if (best_norm > 0.0 && std::isfinite(best_norm)) return best / std::sqrt(best_norm);
+    }
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(c);
+  return eig.eigenvectors().col(0);
+}
+
 // Normal and plane-regularised covariance of point i from its `found` nearest (the point itself among
 // them); false (isotropic, no normal) with fewer than 3.
 bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t found, double plane_epsilon) {
@@ -46,10 +80,8 @@ bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t
   cov(1, 1) = syy * inv - my * my;
   cov(1, 2) = cov(2, 1) = syz * inv - my * mz;
   cov(2, 2) = szz * inv - mz * mz;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  eig.computeDirect(cov);
   // U·diag(ε, 1, 1)·Uᵀ = I − (1 − ε)·n·nᵀ for orthonormal U: only the normal is needed.
-  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  Eigen::Vector3d normal = smallestEigenvector(cov);
   cloud.covariances[i].topLeftCorner<3, 3>() =
       Eigen::Matrix3d::Identity() - (1.0 - plane_epsilon) * (normal * normal.transpose());
   if (normal.dot(cloud.points[i].head<3>()) > 0.0) normal = -normal;  // face the sensor at the origin
