@@ -85,6 +85,12 @@ struct Mapper::Impl {
   Pose last_pose = Pose::Identity(), prev_pose = Pose::Identity();
 
   bool deterministic = true;
+  bool defer_dense_clouds = false;
+
+  std::shared_ptr<const Scan> denseCloud(const Scan& deskewed) const {
+    return std::make_shared<const Scan>(
+        toScan(reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_dense_map), deskewed));
+  }
 
   Impl(const config::Parameters& p, bool det) : params(p), tracker(p), deterministic(det) {
     if (p.mapping_registrator == "ndt") use_ndt = true;
@@ -325,9 +331,10 @@ struct Mapper::Impl {
       have_last = true;
     }
 
-    if (out.frame.stored())
-      out.cloud = std::make_shared<const Scan>(
-          toScan(reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_dense_map), scan));
+    if (out.frame.stored()) {
+      if (defer_dense_clouds) out.deskewed = std::make_shared<const Scan>(deskewed);
+      else out.cloud = denseCloud(deskewed);
+    }
     // A lost keyframe restarts the local map (upstream); a failed registration does not feed it, unless
     // registrations keep failing (the map was restarted from a partial sweep, or the vehicle got far off
     // the prediction): then the map restarts from this frame at its predicted pose.
@@ -345,6 +352,8 @@ Mapper::Mapper(const config::Parameters& params, bool deterministic)
     : impl_(std::make_unique<Impl>(params, deterministic)) {}
 Mapper::~Mapper() = default;
 MapperOutput Mapper::process(const Scan& scan) { return impl_->process(scan); }
+void Mapper::deferDenseClouds(bool defer) { impl_->defer_dense_clouds = defer; }
+std::shared_ptr<const Scan> Mapper::denseCloud(const Scan& deskewed) const { return impl_->denseCloud(deskewed); }
 const FrameTracker& Mapper::tracker() const { return impl_->tracker; }
 bool Mapper::done() const { return impl_->tracker.full(); }
 std::size_t Mapper::localMapPoints() const { return impl_->target ? impl_->target->size() : 0; }

@@ -31,8 +31,11 @@ struct MapperOutput {
   MappingFrame frame;
   RegistrationSummary registration;
   /// Stored frames only: the deskewed cloud in the lidar frame at frame.stamp_ns, voxelised at
-  /// leaf_size_dense_map (positions; intensity is the voxel's mean, other fields zero).
+  /// leaf_size_dense_map (positions; intensity is the voxel's mean, other fields zero). With
+  /// Mapper::deferDenseClouds() left empty: the caller makes it from `deskewed` with Mapper::denseCloud().
   std::shared_ptr<const Scan> cloud;
+  /// Stored frames, deferred dense clouds only: the deskewed scan `cloud` is made from.
+  std::shared_ptr<const Scan> deskewed;
 };
 
 class Mapper {
@@ -49,6 +52,11 @@ class Mapper {
   Mapper& operator=(const Mapper&) = delete;
 
   MapperOutput process(const Scan& scan);
+  /// process() leaves the voxelisation of stored frames' dense clouds (milliseconds per frame) to the
+  /// caller, who publishes the pose first and then calls denseCloud(*out.deskewed).
+  void deferDenseClouds(bool defer);
+  /// A stored frame's dense cloud (MapperOutput::cloud) from its deskewed scan.
+  [[nodiscard]] std::shared_ptr<const Scan> denseCloud(const Scan& deskewed) const;
 
   [[nodiscard]] const FrameTracker& tracker() const;
   /// mapping_max_frames frames are stored: further scans are skipped.
