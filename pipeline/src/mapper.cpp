@@ -6,6 +6,7 @@
 #include <deque>
 #include <chrono>
 #include <future>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -85,7 +86,25 @@ struct Mapper::Impl {
   Pose last_pose = Pose::Identity(), prev_pose = Pose::Identity();
 
   bool deterministic = true;
-  bool defer_dense_clouds = false;
+  bool defer_post_pose = false;
+  struct PendingKeyframe {
+    std::shared_ptr<const Scan> deskewed;
+    Pose pose;
+    bool restart = false;
+  };
+  std::optional<PendingKeyframe> pending_keyframe;  // deferred post-pose work
+
+  void finishFrame(MapperOutput& out) {
+    if (out.deskewed) {
+      out.cloud = denseCloud(*out.deskewed);
+      out.deskewed.reset();
+    }
+    if (pending_keyframe) {
+      const PendingKeyframe k = std::move(*pending_keyframe);
+      pending_keyframe.reset();
+      addKeyframe(*k.deskewed, k.pose, k.restart);
+    }
+  }
 
   std::shared_ptr<const Scan> denseCloud(const Scan& deskewed) const {
     return std::make_shared<const Scan>(
@@ -237,6 +256,10 @@ struct Mapper::Impl {
   }
 
   MapperOutput process(const Scan& input) {
+    if (pending_keyframe) {  // the caller did not finish the last frame: the map must not miss it
+      MapperOutput last;
+      finishFrame(last);
+    }
     MapperOutput out;
     if (tracker.full()) {
       out.skipped_reason = "mapper full (mapping_max_frames)";
@@ -331,19 +354,23 @@ struct Mapper::Impl {
       have_last = true;
     }
 
-    if (out.frame.stored()) {
-      if (defer_dense_clouds) out.deskewed = std::make_shared<const Scan>(deskewed);
-      else out.cloud = denseCloud(deskewed);
-    }
     // A lost keyframe restarts the local map (upstream); a failed registration does not feed it, unless
     // registrations keep failing (the map was restarted from a partial sweep, or the vehicle got far off
     // the prediction): then the map restarts from this frame at its predicted pose.
     failures_in_a_row = out.registration.ok ? 0 : failures_in_a_row + 1;
-    if (out.frame.isKeyframe() && out.registration.ok) addKeyframe(deskewed, pose, out.frame.lost || !target);
-    else if (failures_in_a_row >= kRestartAfterFailures) {
-      addKeyframe(deskewed, pose, true);
+    bool feed = false, restart = false;
+    if (out.frame.isKeyframe() && out.registration.ok) {
+      feed = true;
+      restart = out.frame.lost || !target;
+    } else if (failures_in_a_row >= kRestartAfterFailures) {
+      feed = restart = true;
       failures_in_a_row = 0;
     }
+    std::shared_ptr<const Scan> shared_deskewed;
+    if (out.frame.stored() || feed) shared_deskewed = std::make_shared<const Scan>(std::move(deskewed));
+    if (out.frame.stored()) out.deskewed = shared_deskewed;
+    if (feed) pending_keyframe = PendingKeyframe{shared_deskewed, pose, restart};
+    if (!defer_post_pose) finishFrame(out);
     return out;
   }
 };
@@ -352,8 +379,8 @@ Mapper::Mapper(const config::Parameters& params, bool deterministic)
     : impl_(std::make_unique<Impl>(params, deterministic)) {}
 Mapper::~Mapper() = default;
 MapperOutput Mapper::process(const Scan& scan) { return impl_->process(scan); }
-void Mapper::deferDenseClouds(bool defer) { impl_->defer_dense_clouds = defer; }
-std::shared_ptr<const Scan> Mapper::denseCloud(const Scan& deskewed) const { return impl_->denseCloud(deskewed); }
+void Mapper::deferPostPoseWork(bool defer) { impl_->defer_post_pose = defer; }
+void Mapper::finishFrame(MapperOutput& out) { impl_->finishFrame(out); }
 const FrameTracker& Mapper::tracker() const { return impl_->tracker; }
 bool Mapper::done() const { return impl_->tracker.full(); }
 std::size_t Mapper::localMapPoints() const { return impl_->target ? impl_->target->size() : 0; }

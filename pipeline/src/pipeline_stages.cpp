@@ -92,13 +92,13 @@ void Pipeline::Impl::mapperStage() {
     }
     registered.fetch_add(1);
     const MappingFrame& f = out.frame;
-    // The pose is out (scan-to-pose latency ends here); the stored frame's dense cloud comes after.
+    // The pose is out (scan-to-pose latency ends here); the dense cloud and the local-map feed come after.
     rec_mapper.record(item->t0_ns);
     q_pose.push(PoseItem{f.stamp_ns, f.T_map_lidar, false});
     wake_deskew.signal();
-    if (out.deskewed) {
-      out.cloud = mapper.denseCloud(*out.deskewed);
-      out.deskewed.reset();
+    {
+      std::lock_guard lock(mapper_mutex);
+      mapper.finishFrame(out);
     }
     if (f.stored()) {
       stored.fetch_add(1);

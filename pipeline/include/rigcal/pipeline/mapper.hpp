@@ -32,9 +32,9 @@ struct MapperOutput {
   RegistrationSummary registration;
   /// Stored frames only: the deskewed cloud in the lidar frame at frame.stamp_ns, voxelised at
   /// leaf_size_dense_map (positions; intensity is the voxel's mean, other fields zero). With
-  /// Mapper::deferDenseClouds() left empty: the caller makes it from `deskewed` with Mapper::denseCloud().
+  /// Mapper::deferPostPoseWork() left empty until Mapper::finishFrame().
   std::shared_ptr<const Scan> cloud;
-  /// Stored frames, deferred dense clouds only: the deskewed scan `cloud` is made from.
+  /// Stored frames, deferred post-pose work only: the deskewed scan `cloud` is made from.
   std::shared_ptr<const Scan> deskewed;
 };
 
@@ -52,11 +52,12 @@ class Mapper {
   Mapper& operator=(const Mapper&) = delete;
 
   MapperOutput process(const Scan& scan);
-  /// process() leaves the voxelisation of stored frames' dense clouds (milliseconds per frame) to the
-  /// caller, who publishes the pose first and then calls denseCloud(*out.deskewed).
-  void deferDenseClouds(bool defer);
-  /// A stored frame's dense cloud (MapperOutput::cloud) from its deskewed scan.
-  [[nodiscard]] std::shared_ptr<const Scan> denseCloud(const Scan& deskewed) const;
+  /// With `defer`, process() stops once the pose is known: the stored frame's dense cloud (voxelised from
+  /// `deskewed`) and feeding a keyframe to the local map (milliseconds) are left to finishFrame(), which
+  /// the caller runs after publishing the pose (the next process() runs it if the caller did not).
+  void deferPostPoseWork(bool defer);
+  /// Completes the last process() output: fills out.cloud from out.deskewed and feeds the local map.
+  void finishFrame(MapperOutput& out);
 
   [[nodiscard]] const FrameTracker& tracker() const;
   /// mapping_max_frames frames are stored: further scans are skipped.
