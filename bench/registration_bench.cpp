@@ -358,6 +358,29 @@ void printTable() {
 // s2s-gicp-cov, s2s-gicp, s2m-gicp-cov, s2m-gicp or cov (source covariances alone).
 int profile(const std::string& which, int runs) {
   const Scenario* s = which.rfind("s2m", 0) == 0 ? &g_data->map : &g_data->scan;
+  // s2s-target / s2m-target: a Target from positions only (tree, covariances, neighbour graph; no NDT
+  // grid), 1 thread: what the mapper's local-map build does at each keyframe.
+  if (which.find("-target") != std::string::npos) {
+    PointCloud positions;
+    positions.points = s->target->cloud().points;
+    TargetOptions target_options;
+    target_options.normals_and_covariances = true;
+    std::vector<double> target_ms;
+    std::size_t graph_size = 0;
+    for (int i = 0; i < runs; ++i) {
+      PointCloud copy = positions;
+      const auto start = std::chrono::steady_clock::now();
+      CALLGRIND_START_INSTRUMENTATION;
+      const Target t(std::move(copy), target_options);
+      CALLGRIND_STOP_INSTRUMENTATION;
+      target_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      graph_size = t.neighborGraph().neighbors.size();
+    }
+    std::sort(target_ms.begin(), target_ms.end());
+    std::printf("%s: %zu points, %d runs, median %.2f ms, min %.2f ms (graph entries %zu)\n", which.c_str(),
+                positions.size(), runs, target_ms[target_ms.size() / 2], target_ms[0], graph_size);
+    return 0;
+  }
   const bool with_cov = which == "cov" || which.find("-cov") != std::string::npos;
   GicpParams params = common<GicpParams>(1);
   params.max_correspondence_distance = 1.0;

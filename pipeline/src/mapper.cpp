@@ -6,6 +6,7 @@
 #include <deque>
 #include <chrono>
 #include <future>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -85,6 +86,30 @@ struct Mapper::Impl {
   Pose last_pose = Pose::Identity(), prev_pose = Pose::Identity();
 
   bool deterministic = true;
+  bool defer_post_pose = false;
+  struct PendingKeyframe {
+    std::shared_ptr<const Scan> deskewed;
+    Pose pose;
+    bool restart = false;
+  };
+  std::optional<PendingKeyframe> pending_keyframe;  // deferred post-pose work
+
+  void finishFrame(MapperOutput& out) {
+    if (out.deskewed) {
+      out.cloud = denseCloud(*out.deskewed);
+      out.deskewed.reset();
+    }
+    if (pending_keyframe) {
+      const PendingKeyframe k = std::move(*pending_keyframe);
+      pending_keyframe.reset();
+      addKeyframe(*k.deskewed, k.pose, k.restart);
+    }
+  }
+
+  std::shared_ptr<const Scan> denseCloud(const Scan& deskewed) const {
+    return std::make_shared<const Scan>(
+        toScan(reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_dense_map), deskewed));
+  }
 
   Impl(const config::Parameters& p, bool det) : params(p), tracker(p), deterministic(det) {
     if (p.mapping_registrator == "ndt") use_ndt = true;
@@ -93,12 +118,13 @@ struct Mapper::Impl {
   }
 
   static std::shared_ptr<const reg::Target> buildTarget(const std::vector<KeyframeCloud>& clouds,
-                                                        const config::Parameters& params, bool use_ndt) {
+                                                        const config::Parameters& params, bool use_ndt,
+                                                        int threads) {
     reg::PointCloud merged;
     for (const auto& k : clouds) merged.points.insert(merged.points.end(), k->points.begin(), k->points.end());
     merged = reg::voxelDownsample(merged, params.leaf_size_local_map);
     reg::TargetOptions o;
-    o.num_threads = std::max(1, params.mapper_num_threads);
+    o.num_threads = threads;
     if (use_ndt) o.ndt_resolutions = {params.mapper_resolution};
     else o.normals_and_covariances = true;
     return std::make_shared<const reg::Target>(std::move(merged), o);
@@ -146,11 +172,15 @@ struct Mapper::Impl {
     std::vector<KeyframeCloud> clouds(local.begin(), local.end());
     scans_since_launch = 0;
     rebuild_wanted = false;
-    pending_target = std::async(std::launch::async, [clouds = std::move(clouds), p = params, ndt = use_ndt] {
+    // Real time: one build thread, so the registering threads keep one core to themselves (a build on
+    // both cores slows both halves of every registration's parallel loop). Offline: as fast as possible.
+    // The Target is the same whatever the thread count.
+    const int threads = deterministic ? std::max(1, params.mapper_num_threads) : 1;
+    pending_target = std::async(std::launch::async, [clouds = std::move(clouds), p = params, ndt = use_ndt, threads] {
       // Below the registering thread: a build (~5x one registration's CPU) must not stretch the scans
       // that register meanwhile, on two cores. Its helper threads inherit the niceness.
       ::setpriority(PRIO_PROCESS, id_t(::gettid()), kBuildNiceness);
-      return buildTarget(clouds, p, ndt);
+      return buildTarget(clouds, p, ndt, threads);
     });
   }
 
@@ -226,6 +256,10 @@ struct Mapper::Impl {
   }
 
   MapperOutput process(const Scan& input) {
+    if (pending_keyframe) {  // the caller did not finish the last frame: the map must not miss it
+      MapperOutput last;
+      finishFrame(last);
+    }
     MapperOutput out;
     if (tracker.full()) {
       out.skipped_reason = "mapper full (mapping_max_frames)";
@@ -320,18 +354,23 @@ struct Mapper::Impl {
       have_last = true;
     }
 
-    if (out.frame.stored())
-      out.cloud = std::make_shared<const Scan>(
-          toScan(reg::voxelDownsample(reg::fromScan(deskewed), params.leaf_size_dense_map), scan));
     // A lost keyframe restarts the local map (upstream); a failed registration does not feed it, unless
     // registrations keep failing (the map was restarted from a partial sweep, or the vehicle got far off
     // the prediction): then the map restarts from this frame at its predicted pose.
     failures_in_a_row = out.registration.ok ? 0 : failures_in_a_row + 1;
-    if (out.frame.isKeyframe() && out.registration.ok) addKeyframe(deskewed, pose, out.frame.lost || !target);
-    else if (failures_in_a_row >= kRestartAfterFailures) {
-      addKeyframe(deskewed, pose, true);
+    bool feed = false, restart = false;
+    if (out.frame.isKeyframe() && out.registration.ok) {
+      feed = true;
+      restart = out.frame.lost || !target;
+    } else if (failures_in_a_row >= kRestartAfterFailures) {
+      feed = restart = true;
       failures_in_a_row = 0;
     }
+    std::shared_ptr<const Scan> shared_deskewed;
+    if (out.frame.stored() || feed) shared_deskewed = std::make_shared<const Scan>(std::move(deskewed));
+    if (out.frame.stored()) out.deskewed = shared_deskewed;
+    if (feed) pending_keyframe = PendingKeyframe{shared_deskewed, pose, restart};
+    if (!defer_post_pose) finishFrame(out);
     return out;
   }
 };
@@ -340,6 +379,8 @@ Mapper::Mapper(const config::Parameters& params, bool deterministic)
     : impl_(std::make_unique<Impl>(params, deterministic)) {}
 Mapper::~Mapper() = default;
 MapperOutput Mapper::process(const Scan& scan) { return impl_->process(scan); }
+void Mapper::deferPostPoseWork(bool defer) { impl_->defer_post_pose = defer; }
+void Mapper::finishFrame(MapperOutput& out) { impl_->finishFrame(out); }
 const FrameTracker& Mapper::tracker() const { return impl_->tracker; }
 bool Mapper::done() const { return impl_->tracker.full(); }
 std::size_t Mapper::localMapPoints() const { return impl_->target ? impl_->target->size() : 0; }

@@ -127,7 +127,7 @@ PipelineStats Pipeline::stats() const {
   return s;
 }
 
-MappingResult Pipeline::mapping() const {
+MappingResult Pipeline::mapping(bool with_dense_cloud) const {
   const Impl& m = *impl_;
   MappingResult r;
   r.mapping_sensor = m.sensors[0];
@@ -139,12 +139,13 @@ MappingResult Pipeline::mapping() const {
   }
   std::lock_guard lock(m.store_mutex);
   if (m.stored_keyframes.empty()) {
-    r.dense_cloud = std::make_shared<const Scan>();
+    if (with_dense_cloud) r.dense_cloud = std::make_shared<const Scan>();
     return r;
   }
   const MappingFrame& last_kf = m.stored_frames[m.stored_keyframes.back()];
   for (std::size_t i = 0; i < r.trajectory.size(); ++i)
     if (r.trajectory[i].sequence == last_kf.sequence) r.last_keyframe_frame = int(i);
+  if (!with_dense_cloud) return r;
   const int n = m.params.dense_pointcloud_num_keyframes;
   const std::size_t first = m.stored_keyframes[std::size_t(std::max(0, int(m.stored_keyframes.size()) - 1 - n))];
   registration::PointCloud merged;

@@ -176,6 +176,7 @@ struct Pipeline::Impl {
         q_cal(std::max<std::size_t>(2, o.queue_capacity)),
         q_cand(kLosslessCapacity),
         mapper(r.parameters, o.mode == PipelineMode::kOffline) {
+    mapper.deferPostPoseWork(true);  // the mapper stage publishes the pose before the frame's other work
     if (rig.roles.mapping_lidar.empty()) throw std::runtime_error(rig.file.string() + ": no mapping_lidar role");
     sensors.push_back(rig.roles.mapping_lidar);
     for (const auto& c : rig.roles.calibration_lidars) sensors.push_back(c);

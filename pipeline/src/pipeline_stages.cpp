@@ -92,6 +92,14 @@ void Pipeline::Impl::mapperStage() {
     }
     registered.fetch_add(1);
     const MappingFrame& f = out.frame;
+    // The pose is out (scan-to-pose latency ends here); the dense cloud and the local-map feed come after.
+    rec_mapper.record(item->t0_ns);
+    q_pose.push(PoseItem{f.stamp_ns, f.T_map_lidar, false});
+    wake_deskew.signal();
+    {
+      std::lock_guard lock(mapper_mutex);
+      mapper.finishFrame(out);
+    }
     if (f.stored()) {
       stored.fetch_add(1);
       std::lock_guard lock(store_mutex);
@@ -102,9 +110,6 @@ void Pipeline::Impl::mapperStage() {
     if (f.isKeyframe()) keyframes.fetch_add(1);
     if (f.kind == FrameKind::kStopped || f.kind == FrameKind::kStoppedKeyframe) stopped.fetch_add(1);
     if (f.lost) lost.fetch_add(1);
-    rec_mapper.record(item->t0_ns);
-    q_pose.push(PoseItem{f.stamp_ns, f.T_map_lidar, false});
-    wake_deskew.signal();
     q_frames.push(FrameItem{std::move(out), false});
     wake_pairing.signal();
   }

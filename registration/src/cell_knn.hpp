@@ -4,7 +4,8 @@
 // in its own and the 26 surrounding cells. All points of one cell share those candidates, gathered once
 // into a small contiguous float array, so a query is a tight distance loop instead of a tree walk.
 // Exact: a point's answer is kept only when its k-th distance is provably smaller than the distance to
-// anything outside the 3x3x3 block; the rest (sparse outskirts) are listed for a kd-tree query.
+// anything outside the 3x3x3 block; the rest (sparse outskirts, over-crowded blocks) are searched
+// further or listed for a kd-tree query.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -26,7 +27,9 @@ struct CellKnn {
 /// All-k-NN of `points` (finite). Like KdTree::knn(points[i], k) for every i, up to the order of equally
 /// distant points. Deterministic and independent of num_threads. Returns false (and leaves `out`
 /// unspecified) when a grid does not suit the cloud (too few points, or an extent no cell size covers);
-/// then use the tree for everything.
-bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_threads, CellKnn* out);
+/// then use the tree for everything. `tree_at_hand`: the caller already has a tree, so what the 3x3x3
+/// block cannot prove is listed as unproven at once instead of searched further on the grid.
+bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_threads, bool tree_at_hand,
+             CellKnn* out);
 
 }  // namespace rigcal::registration::detail

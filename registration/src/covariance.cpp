@@ -14,6 +14,40 @@ namespace rigcal::registration {
 
 namespace {
 
+// Unit eigenvector of the smallest eigenvalue of a symmetric 3x3 matrix. Only that one is needed, so
+// instead of a full decomposition (Eigen's computeDirect: ~1.1k instructions, a third of them atan2 and
+// sincos) the eigenvalues come from the trigonometric closed form and the vector from the largest cross
+// product of two rows of (C − λ_min·I). Where the two smallest eigenvalues nearly coincide (a line, a
+// blob: the normal is ill-defined and the cross products lose precision) Eigen's solver decides, as before.
+Eigen::Vector3d smallestEigenvector(const Eigen::Matrix3d& c) {
+  const double mean = c.trace() / 3.0;
+  Eigen::Matrix3d b = c;
+  b.diagonal().array() -= mean;
+  const double p = std::sqrt(b.squaredNorm() / 6.0);
+  if (p > 1e-150 * std::max(1.0, std::abs(mean))) {
+    const double half_det = (b / p).determinant() / 2.0;
+    // φ in [0, π/3]; cos(φ + 2π/3) = −cos φ / 2 − sin φ·√3/2 spares a second cosine.
+    const double cos_phi = std::cos(std::acos(std::clamp(half_det, -1.0, 1.0)) / 3.0);
+    const double sin_phi = std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi));
+    const double largest = mean + 2.0 * p * cos_phi;
+    const double smallest = mean - p * (cos_phi + 1.7320508075688772935 * sin_phi);
+    const double middle = 3.0 * mean - largest - smallest;
+    if (middle - smallest > 1e-3 * (largest - smallest)) {
+      Eigen::Matrix3d m = c;
+      m.diagonal().array() -= smallest;
+      const Eigen::Vector3d c01 = m.row(0).cross(m.row(1)), c02 = m.row(0).cross(m.row(2)),
+                            c12 = m.row(1).cross(m.row(2));
+      const double n01 = c01.squaredNorm(), n02 = c02.squaredNorm(), n12 = c12.squaredNorm();
+      const Eigen::Vector3d& best = n01 >= n02 ? (n01 >= n12 ? c01 : c12) : (n02 >= n12 ? c02 : c12);
+      const double best_norm = std::max({n01, n02, n12});
+      if (best_norm > 0.0 && std::isfinite(best_norm)) return best / std::sqrt(best_norm);
+    }
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(c);
+  return eig.eigenvectors().col(0);
+}
+
 // Normal and plane-regularised covariance of point i from its `found` nearest (the point itself among
 // them); false (isotropic, no normal) with fewer than 3.
 bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t found, double plane_epsilon) {
@@ -46,10 +80,8 @@ bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t
   cov(1, 1) = syy * inv - my * my;
   cov(1, 2) = cov(2, 1) = syz * inv - my * mz;
   cov(2, 2) = szz * inv - mz * mz;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  eig.computeDirect(cov);
   // U·diag(ε, 1, 1)·Uᵀ = I − (1 − ε)·n·nᵀ for orthonormal U: only the normal is needed.
-  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  Eigen::Vector3d normal = smallestEigenvector(cov);
   cloud.covariances[i].topLeftCorner<3, 3>() =
       Eigen::Matrix3d::Identity() - (1.0 - plane_epsilon) * (normal * normal.transpose());
   if (normal.dot(cloud.points[i].head<3>()) > 0.0) normal = -normal;  // face the sensor at the origin
@@ -57,14 +89,46 @@ bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t
   return true;
 }
 
-}  // namespace
-
-CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const CovarianceOptions& options,
-                                    NeighborGraph* graph, std::size_t graph_degree) {
+// Every point's k nearest (itself among them), closest first: the cell grid for all it can prove, the
+// tree for the rest (sparse outskirts) or for everything when a grid does not suit the cloud. `tree`, when
+// given, must be over cloud.points; otherwise one is built only if some point needs it.
+detail::CellKnn allNearest(const PointCloud& cloud, std::size_t k, int num_threads, const KdTree* tree) {
   const std::size_t n = cloud.size();
-  const std::size_t k = static_cast<std::size_t>(std::max(options.num_neighbors, 3));
-  const std::size_t degree = graph != nullptr ? graph_degree : 0;
-  const std::size_t k_query = std::max(k, degree + 2);  // the graph may want more points than the covariance
+  detail::CellKnn knn;
+  const bool grid = detail::cellKnn(cloud.points, k, num_threads, tree != nullptr, &knn);
+  if (!grid) {
+    knn.k = k;
+    knn.neighbors.assign(n * k, Neighbor{});
+    knn.count.assign(n, 0);
+    knn.unproven.resize(n);
+    for (std::size_t i = 0; i < n; ++i) knn.unproven[i] = static_cast<std::uint32_t>(i);
+  }
+  if (knn.unproven.empty()) return knn;
+  KdTree own;
+  if (tree == nullptr) {
+    KdTreeOptions tree_options;
+    tree_options.num_threads = num_threads;
+    own = KdTree(cloud.points, tree_options);
+    tree = &own;
+  }
+  const std::size_t m = knn.unproven.size();
+  parallelFor(chunkCount(m, kDefaultChunk), num_threads, [&](std::size_t task) {
+    for (std::size_t u = task * kDefaultChunk; u < std::min(m, (task + 1) * kDefaultChunk); ++u) {
+      const std::uint32_t i = knn.unproven[u];
+      knn.count[i] = static_cast<std::uint32_t>(tree->knn(cloud.points[i], k, knn.neighbors.data() + i * k));
+    }
+  });
+  knn.unproven.clear();
+  return knn;
+}
+
+// Normals and covariances from the first k of each point's neighbours and, with `graph`, its first
+// `degree` other points; the next other point bounds the distance of everything not listed: that is the
+// radius the list vouches for.
+CovarianceStats shapesAndGraph(PointCloud& cloud, const detail::CellKnn& knn, std::size_t k,
+                               const CovarianceOptions& options, NeighborGraph* graph, std::size_t degree) {
+  const std::size_t n = cloud.size();
+  const std::size_t k_query = knn.k;
   if (graph != nullptr) {
     graph->degree = degree;
     graph->neighbors.assign(n * degree, 0);
@@ -73,17 +137,12 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
   cloud.normals.assign(n, Eigen::Vector4d::Zero());
   cloud.covariances.assign(n, Eigen::Matrix4d::Zero());
   std::atomic<std::size_t> isolated{0};
-
   parallelFor(chunkCount(n, kDefaultChunk), options.num_threads, [&](std::size_t task) {
-    std::vector<Neighbor> nb(k_query);
-    const std::size_t begin = task * kDefaultChunk;
-    const std::size_t end = std::min(n, begin + kDefaultChunk);
     std::size_t local_isolated = 0;
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::size_t all = tree.knn(cloud.points[i], k_query, nb.data());
+    for (std::size_t i = task * kDefaultChunk; i < std::min(n, (task + 1) * kDefaultChunk); ++i) {
+      const Neighbor* nb = knn.neighbors.data() + i * k_query;
+      const std::size_t all = knn.count[i];
       if (degree > 0) {
-        // Sorted by distance; list the first `degree` others. The next other point bounds the distance
-        // of everything not listed: that is the radius the list vouches for.
         std::uint32_t* list = graph->neighbors.data() + i * degree;
         std::size_t m = 0, next = all;
         for (std::size_t j = 0; j < all; ++j) {
@@ -96,48 +155,28 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
         }
         if (m == degree && next < all) graph->radius[i] = std::sqrt(nb[next].sq_distance);
       }
-      if (!fillShape(cloud, i, nb.data(), std::min(all, k), options.plane_epsilon)) ++local_isolated;
+      if (!fillShape(cloud, i, nb, std::min(all, k), options.plane_epsilon)) ++local_isolated;
     }
     isolated.fetch_add(local_isolated, std::memory_order_relaxed);
   });
   return {n, isolated.load()};
 }
 
-CovarianceStats estimateCovariances(PointCloud& cloud, const CovarianceOptions& options) {
-  // The all-k-NN on a cell grid (no tree to build, most queries a short distance loop); the tree
-  // answers only the points the grid cannot prove (sparse outskirts), or all when a grid does not suit.
-  const std::size_t n = cloud.size();
+}  // namespace
+
+CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const CovarianceOptions& options,
+                                    NeighborGraph* graph, std::size_t graph_degree) {
   const std::size_t k = static_cast<std::size_t>(std::max(options.num_neighbors, 3));
-  detail::CellKnn knn;
-  if (!detail::cellKnn(cloud.points, k, options.num_threads, &knn)) {
-    KdTreeOptions tree_options;
-    tree_options.num_threads = options.num_threads;
-    const KdTree tree(cloud.points, tree_options);
-    return estimateCovariances(cloud, tree, options);
-  }
-  if (!knn.unproven.empty()) {
-    KdTreeOptions tree_options;
-    tree_options.num_threads = options.num_threads;
-    const KdTree tree(cloud.points, tree_options);
-    const std::size_t m = knn.unproven.size();
-    parallelFor(chunkCount(m, kDefaultChunk), options.num_threads, [&](std::size_t task) {
-      for (std::size_t u = task * kDefaultChunk; u < std::min(m, (task + 1) * kDefaultChunk); ++u) {
-        const std::uint32_t i = knn.unproven[u];
-        knn.count[i] = static_cast<std::uint32_t>(tree.knn(cloud.points[i], k, knn.neighbors.data() + i * k));
-      }
-    });
-  }
-  cloud.normals.assign(n, Eigen::Vector4d::Zero());
-  cloud.covariances.assign(n, Eigen::Matrix4d::Zero());
-  std::atomic<std::size_t> isolated{0};
-  parallelFor(chunkCount(n, kDefaultChunk), options.num_threads, [&](std::size_t task) {
-    std::size_t local_isolated = 0;
-    for (std::size_t i = task * kDefaultChunk; i < std::min(n, (task + 1) * kDefaultChunk); ++i) {
-      if (!fillShape(cloud, i, knn.neighbors.data() + i * k, knn.count[i], options.plane_epsilon)) ++local_isolated;
-    }
-    isolated.fetch_add(local_isolated, std::memory_order_relaxed);
-  });
-  return {n, isolated.load()};
+  const std::size_t degree = graph != nullptr ? graph_degree : 0;
+  const std::size_t k_query = std::max(k, degree + 2);  // the graph wants itself, `degree` others and the next
+  const detail::CellKnn knn = allNearest(cloud, k_query, options.num_threads, &tree);
+  return shapesAndGraph(cloud, knn, k, options, graph, degree);
+}
+
+CovarianceStats estimateCovariances(PointCloud& cloud, const CovarianceOptions& options) {
+  const std::size_t k = static_cast<std::size_t>(std::max(options.num_neighbors, 3));
+  const detail::CellKnn knn = allNearest(cloud, k, options.num_threads, nullptr);
+  return shapesAndGraph(cloud, knn, k, options, nullptr, 0);
 }
 
 }  // namespace rigcal::registration

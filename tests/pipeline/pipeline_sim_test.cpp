@@ -303,7 +303,7 @@ test::RunResult replay(const config::RigConfig& rig, const std::vector<Scan>& sc
   for (const Scan& s : scans) pipeline.push(s);
   if (push_seconds) *push_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   pipeline.finish();
-  r.mapping = pipeline.mapping();
+  r.mapping = pipeline.mapping(/*with_dense_cloud=*/true);
   r.progress = pipeline.progress();
   r.stats = pipeline.stats();
   r.shortfalls = pipeline.shortfalls();

@@ -53,7 +53,7 @@ inline RunResult runInProcess(const sim::Simulation& sim, const config::RigConfi
   so.max_duration_ns = fromSeconds(duration_s);
   sim.run(feeder, so);
   pipeline.finish();
-  r.mapping = pipeline.mapping();
+  r.mapping = pipeline.mapping(/*with_dense_cloud=*/true);
   r.progress = pipeline.progress();
   r.stats = pipeline.stats();
   r.shortfalls = pipeline.shortfalls();

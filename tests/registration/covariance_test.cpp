@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "rigcal/registration/ndt_grid.hpp"
 #include "rigcal/registration/target.hpp"
 #include "scenes.hpp"
@@ -98,6 +100,87 @@ TEST(Covariance, GridNeighbourhoodsEqualTheTrees) {
     EXPECT_EQ(differ, 0u) << "of " << a.size() << " points, offset " << offset.transpose();
     EXPECT_LE(ties, 3u) << "float ties are rare on jittered points";
   }
+}
+
+// The Target's pass (covariances + neighbour graph, grid first, the given tree for what the grid cannot
+// prove or for crowded blocks) against a plain tree query per point: each graph entry is as far as the
+// tree's neighbour of the same rank (equal up to the order of ties), the radius is the next other point's
+// distance, each covariance is the one of the tree's k nearest. The cloud mixes a jittered room, a
+// denser copy (crowded blocks) and isolated points (unproven); 1 and 2 threads give identical results.
+// Both rank by float distances (the tree's relative to its centre, up to ~100 m away here: ~1e-5 m).
+double floatSlack(double d2) { return 1e-5 * d2 + 1e-4 * std::sqrt(d2); }
+bool kthIsATie(const PointCloud& c, std::size_t i, int k) {
+  std::vector<double> d2;
+  for (const auto& p : c.points) d2.push_back((p.head<3>() - c.points[i].head<3>()).squaredNorm());
+  std::sort(d2.begin(), d2.end());
+  const auto tie = [&](std::size_t j) { return j + 1 < d2.size() && d2[j + 1] - d2[j] <= floatSlack(d2[j + 1]); };
+  return tie(std::size_t(k) - 1) || tie(std::size_t(k));
+}
+
+TEST(Covariance, TargetGraphAndCovariancesEqualTheTrees) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> jitter(-0.02, 0.02);
+  PointCloud cloud = test::room(0.12);
+  for (auto& p : cloud.points) p.head<3>() += Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+  PointCloud dense = test::room(0.02);
+  for (auto& p : dense.points) {
+    if (p.head<3>().norm() < 1.5)
+      cloud.points.push_back(p + Eigen::Vector4d(jitter(rng), jitter(rng), jitter(rng), 0.0) * 0.3);
+  }
+  for (int i = 0; i < 20; ++i) cloud.add(40.0 + 3.0 * i, -7.0 * i, 0.5 * i);
+  const KdTree tree(cloud.points);
+  constexpr std::size_t kDegree = 10;
+  const int k = CovarianceOptions{}.num_neighbors;
+  PointCloud a = cloud, b = cloud;
+  NeighborGraph graph_a, graph_b;
+  CovarianceOptions two;
+  two.num_threads = 2;
+  estimateCovariances(a, tree, {}, &graph_a, kDegree);
+  estimateCovariances(b, tree, two, &graph_b, kDegree);
+  EXPECT_EQ(graph_a.neighbors, graph_b.neighbors);
+  EXPECT_EQ(graph_a.radius, graph_b.radius);
+  std::size_t wrong_graph = 0, wrong_shape = 0, ties = 0;
+  std::vector<Neighbor> nb(kDegree + 2);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_EQ(a.covariances[i], b.covariances[i]) << i;
+    const std::size_t found = tree.knn(cloud.points[i], kDegree + 2, nb.data());
+    std::vector<double> others;
+    for (std::size_t j = 0; j < found; ++j) {
+      if (nb[j].index != i) others.push_back((cloud.points[nb[j].index] - cloud.points[i]).head<3>().squaredNorm());
+    }
+    ASSERT_GE(others.size(), kDegree + 1);
+    for (std::size_t r = 0; r < kDegree; ++r) {
+      const double d2 = (cloud.points[graph_a.of(i)[r]] - cloud.points[i]).head<3>().squaredNorm();
+      if (std::abs(d2 - others[r]) > floatSlack(others[r])) {
+        ++wrong_graph;
+      }
+    }
+    const double radius = std::sqrt(others[kDegree]);
+    if (std::abs(double(graph_a.radius[i]) - radius) > 1e-4) ++wrong_graph;
+    // The tree's covariance: the plane-regularised shape of its k nearest (the point among them).
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int j = 0; j < k; ++j) mean += cloud.points[nb[j].index].head<3>() - cloud.points[i].head<3>();
+    mean /= k;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int j = 0; j < k; ++j) {
+      const Eigen::Vector3d d = cloud.points[nb[j].index].head<3>() - cloud.points[i].head<3>() - mean;
+      cov += d * d.transpose() / k;
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(cov);
+    const Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    const Eigen::Matrix3d expected = Eigen::Matrix3d::Identity() - (1.0 - 1e-3) * normal * normal.transpose();
+    if ((a.covariances[i].topLeftCorner<3, 3>() - expected).cwiseAbs().maxCoeff() > 1e-6) {
+      if (kthIsATie(cloud, i, k)) {
+        ++ties;
+      } else {
+        ++wrong_shape;
+      }
+    }
+  }
+  EXPECT_EQ(wrong_graph, 0u) << "of " << cloud.size() << " points";
+  EXPECT_EQ(wrong_shape, 0u) << "of " << cloud.size() << " points";
+  EXPECT_LE(ties, 20u) << "float ties of the k-th neighbour are rare on jittered points";
 }
 
 TEST(NdtGrid, GaussiansOfOccupiedVoxels) {

@@ -31,8 +31,11 @@ struct MapperOutput {
   MappingFrame frame;
   RegistrationSummary registration;
   /// Stored frames only: the deskewed cloud in the lidar frame at frame.stamp_ns, voxelised at
-  /// leaf_size_dense_map (positions; intensity is the voxel's mean, other fields zero).
+  /// leaf_size_dense_map (positions; intensity is the voxel's mean, other fields zero). With
+  /// Mapper::deferPostPoseWork() left empty until Mapper::finishFrame().
   std::shared_ptr<const Scan> cloud;
+  /// Stored frames, deferred post-pose work only: the deskewed scan `cloud` is made from.
+  std::shared_ptr<const Scan> deskewed;
 };
 
 class Mapper {
@@ -49,6 +52,12 @@ class Mapper {
   Mapper& operator=(const Mapper&) = delete;
 
   MapperOutput process(const Scan& scan);
+  /// With `defer`, process() stops once the pose is known: the stored frame's dense cloud (voxelised from
+  /// `deskewed`) and feeding a keyframe to the local map (milliseconds) are left to finishFrame(), which
+  /// the caller runs after publishing the pose (the next process() runs it if the caller did not).
+  void deferPostPoseWork(bool defer);
+  /// Completes the last process() output: fills out.cloud from out.deskewed and feeds the local map.
+  void finishFrame(MapperOutput& out);
 
   [[nodiscard]] const FrameTracker& tracker() const;
   /// mapping_max_frames frames are stored: further scans are skipped.

@@ -83,8 +83,9 @@ struct MappingResult {
   std::vector<MappingFrame> trajectory;       // every registered frame (stored, stopped, dropped, lost), in order
   /// The whole map in the map frame (= the first mapping-lidar frame), voxelised at leaf_size_local_map.
   std::shared_ptr<const Scan> map_cloud;
-  /// Stored frames within ±dense_pointcloud_num_keyframes of the last keyframe, in the map frame, voxelised
-  /// at leaf_size_dense_map (for base-lidar calibration). Empty while no keyframe exists.
+  /// Only when asked for (Pipeline::mapping(true): it costs seconds on a long run): stored frames within
+  /// ±dense_pointcloud_num_keyframes of the last keyframe, in the map frame, voxelised at
+  /// leaf_size_dense_map. Empty while no keyframe exists; nullptr when not asked for.
   std::shared_ptr<const Scan> dense_cloud;
   int last_keyframe_frame = -1;  // index into `trajectory` of the keyframe `dense_cloud` is centred on
 };
@@ -148,7 +149,8 @@ class Pipeline {
 
   [[nodiscard]] PipelineProgress progress() const;  // any thread, any time
   [[nodiscard]] PipelineStats stats() const;        // any thread; exact after finish()
-  [[nodiscard]] MappingResult mapping() const;      // a snapshot; complete after finish()
+  /// A snapshot; complete after finish(). `with_dense_cloud` also merges the dense cloud (seconds).
+  [[nodiscard]] MappingResult mapping(bool with_dense_cloud = false) const;
   [[nodiscard]] std::vector<Shortfall> shortfalls() const;  // after finish()
 
  private:
