@@ -78,8 +78,7 @@ struct PointToPointSums {
 
 inline void mirrorUpper(Matrix6d& H) { H.triangularView<Eigen::StrictlyLower>() = H.transpose(); }
 
-/// A symmetric 3x3 by its upper triangle: half the memory of a Matrix3d, and the GICP kernel below only
-/// touches what it needs.
+/// A symmetric 3x3 by its upper triangle: half the memory of a Matrix3d (GICP's weights, covariances).
 struct Sym3 {
   double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
 

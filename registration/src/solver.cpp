@@ -55,6 +55,7 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
     // Each rejected try damps more and halves the trust radius, so steps shrink geometrically until
     // the cost drops (a descent direction always gets there) or they are negligibly small.
     bool accepted = false;
+    bool final_step = false;  // small enough to stop at once if accepted
     Vector6d delta = Vector6d::Zero();
     Pose T_new = out.T;
     double radius = objective.maxStep();
@@ -70,7 +71,8 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
         continue;
       }
       T_new = expSE3(delta) * out.T;  // left perturbation, see kernels.hpp
-      const std::optional<double> c = objective.cost(T_new, deadline, !isConverged(out.T.inverse() * T_new, params));
+      final_step = isConverged(out.T.inverse() * T_new, params);
+      const std::optional<double> c = objective.cost(T_new, deadline, !final_step);
       if (!c) {
         out.status = stopStatus(deadline);
         out.T = out.T_linearized;
@@ -90,9 +92,8 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
       out.status = Status::kConverged;
       return out;
     }
-    const Pose step = out.T.inverse() * T_new;
     out.T = T_new;
-    if (isConverged(step, params)) {
+    if (final_step) {
       out.converged = true;
       out.status = Status::kConverged;
       return out;
