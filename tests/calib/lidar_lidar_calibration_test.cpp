@@ -31,27 +31,13 @@ using Clock = std::chrono::steady_clock;
 
 class LidarLidarSim : public ::testing::Test {
  protected:
-  /// Simulated on first use (each ctest entry is its own process: a test that skips never pays for it).
-  static const test::SimDatasets& data() {
-    if (!data_) {
-      test::SimDatasetOptions o;
-      o.bump_amplitude_m = 0.0;  // the lot keeps its slope; see SimDatasetOptions for why no bumps
-      if (RIGCAL_SANITIZED) {    // instrumented code runs 10-50x slower: a shorter stretch, fewer frames
-        o.seconds = 6.0;
-        o.frames = 2;
-      }
-      data_ = std::make_unique<test::SimDatasets>(test::buildSimDatasets(o));
-    }
-    return *data_;
-  }
-  static void TearDownTestSuite() { data_.reset(); }
+  static const test::SimDatasets& data() { return test::flatParkingLot(); }
+  static void TearDownTestSuite() { test::releaseFlatParkingLot(); }
 
   static double translationError(const Pose& a, const Pose& b) { return (a.translation() - b.translation()).norm(); }
   static double rotationErrorDeg(const Pose& a, const Pose& b) { return rad2deg(rotationAngleBetween(a, b)); }
 
-  static std::unique_ptr<test::SimDatasets> data_;
 };
-std::unique_ptr<test::SimDatasets> LidarLidarSim::data_;
 
 TEST_F(LidarLidarSim, EachCalibrationLidarWithinOneCentimetreAndFiveHundredthsOfADegree) {
   config::Parameters params = data().params;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <stdexcept>
 
@@ -11,6 +12,7 @@
 #include "rigcal/registration/voxel_grid.hpp"
 #include "rigcal/sim/scenario.hpp"
 #include "rigcal/sim/simulation.hpp"
+#include "sanitizers.hpp"
 
 namespace rigcal::test {
 namespace {
@@ -195,5 +197,24 @@ SimDatasets buildSimDatasets(const SimDatasetOptions& options) {
   }
   return out;
 }
+
+namespace {
+std::unique_ptr<SimDatasets> g_flat_parking_lot;
+}  // namespace
+
+const SimDatasets& flatParkingLot() {
+  if (!g_flat_parking_lot) {
+    SimDatasetOptions o;
+    o.bump_amplitude_m = 0.0;  // the lot keeps its slope; see SimDatasetOptions for why no bumps
+    if (RIGCAL_SANITIZED) {    // instrumented code runs 10-50x slower: a shorter stretch, fewer frames
+      o.seconds = 6.0;
+      o.frames = 2;
+    }
+    g_flat_parking_lot = std::make_unique<SimDatasets>(buildSimDatasets(o));
+  }
+  return *g_flat_parking_lot;
+}
+
+void releaseFlatParkingLot() { g_flat_parking_lot.reset(); }
 
 }  // namespace rigcal::test

@@ -43,6 +43,12 @@ struct SimDatasets {
 /// Simulates and builds (a few seconds of CPU: call once per test suite).
 SimDatasets buildSimDatasets(const SimDatasetOptions& options);
 
+/// The lidar-lidar suites' common data: a flat stretch of the parking lot (no bumps; shorter, with fewer
+/// frames, under the sanitizers), built on first use (a suite that skips never pays for it) and kept until
+/// releaseFlatParkingLot() (a suite's TearDownTestSuite).
+const SimDatasets& flatParkingLot();
+void releaseFlatParkingLot();
+
 /// `T` moved by `metres` and `degrees` in fixed pseudo-random directions drawn from `seed`.
 Pose perturb(const Pose& T, double metres, double degrees, std::uint64_t seed);
 

@@ -25,19 +25,8 @@ double secondsFrom(Clock::time_point t) { return std::chrono::duration<double>(C
 
 class LidarLidarWorkerSim : public ::testing::Test {
  protected:
-  static const test::SimDatasets& data() {
-    if (!data_) {
-      test::SimDatasetOptions o;
-      o.bump_amplitude_m = 0.0;
-      if (RIGCAL_SANITIZED) {  // instrumented code runs 10-50x slower: a shorter stretch, fewer frames
-        o.seconds = 6.0;
-        o.frames = 2;
-      }
-      data_ = std::make_unique<test::SimDatasets>(test::buildSimDatasets(o));
-    }
-    return *data_;
-  }
-  static void TearDownTestSuite() { data_.reset(); }
+  static const test::SimDatasets& data() { return test::flatParkingLot(); }
+  static void TearDownTestSuite() { test::releaseFlatParkingLot(); }
 
   static std::shared_ptr<const pipeline::CalibrationDataset> dataset(std::size_t i) {
     return std::make_shared<const pipeline::CalibrationDataset>(data().datasets.at(i));
@@ -65,9 +54,7 @@ class LidarLidarWorkerSim : public ::testing::Test {
     EXPECT_TRUE(r.T_mapping_calib.matrix().allFinite());
   }
 
-  static std::unique_ptr<test::SimDatasets> data_;
 };
-std::unique_ptr<test::SimDatasets> LidarLidarWorkerSim::data_;
 
 // Lidar A's dataset comes alone (its budget filled during the drive), lidar B's after a pause longer than
 // the deadline: A gets half of the 2 s, not all of it; the pause is not calibration time, so B still gets
