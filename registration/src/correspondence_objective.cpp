@@ -7,6 +7,7 @@
 
 #include "gicp_batch.hpp"
 #include "kernels.hpp"
+#include "spatial_order.hpp"
 #include "rigcal/registration/parallel.hpp"
 
 namespace rigcal::registration::detail {
@@ -20,18 +21,32 @@ CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> p
   chunks_ = makeChunks(pairs);
   std::size_t total = 0;
   for (const auto& p : pairs) total += p.source->size();
+  // Every per-point array below is in each source's spatial order, and so are the chunks: a chunk's
+  // queries land on neighbouring target points, which stay in cache from one query to the next.
+  source_points_.reserve(total);
+  std::vector<std::uint32_t> order;
+  order.reserve(total);
+  for (const auto& p : pairs) {
+    const std::vector<std::uint32_t> o = spatialOrder(p.source->points, kOrderCell);
+    for (const std::uint32_t i : o) source_points_.push_back(p.source->points[i]);
+    order.insert(order.end(), o.begin(), o.end());
+  }
   match_.assign(total, kNone);
   used_.assign(total, kNone);
   used_next_.assign(total, kNone);
   second_.assign(total, kNone);
   query_.assign(total, Eigen::Vector3f::Zero());
   margin_.assign(total, -1.0F);
+  held_.resize(total);
   if (kind == Residual::kGicp) {
     weight_.resize(total);
     weight_next_.resize(total);
     source_cov_.reserve(total);
+    std::size_t at = 0;
     for (const auto& p : pairs) {
-      for (const auto& c : p.source->covariances) source_cov_.push_back(Sym3::upperOf(c));
+      for (std::size_t n = 0; n < p.source->size(); ++n, ++at) {
+        source_cov_.push_back(Sym3::upperOf(p.source->covariances[order[at]]));
+      }
     }
     source_axis_.resize(total);
     for (std::size_t g = 0; g < total; ++g) {
@@ -141,6 +156,17 @@ bool CorrespondenceObjective::match(const Target& target, std::size_t g, const E
   return true;
 }
 
+void CorrespondenceObjective::hold(std::size_t g, const Target& target, std::uint32_t j) {
+  Held& h = held_[g];
+  if (h.index == j) return;
+  h.index = j;
+  h.point = target.cloud().points[j].head<3>();
+  if (kind_ == Residual::kGicp) {
+    const float* c = target.covarianceUpperFloat().data() + 6 * std::size_t{j};
+    std::copy(c, c + 6, h.covariance.begin());
+  }
+}
+
 template <Residual K>
 double CorrespondenceObjective::costTerm(std::size_t g, const Eigen::Vector3d& r, const PointCloud& tc,
                                          std::uint32_t j) const {
@@ -159,7 +185,6 @@ double CorrespondenceObjective::costTerm(std::size_t g, const Eigen::Vector3d& r
 template <Residual K, bool kPrevious>
 CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const PairChunk& chunk,
                                                                       const Eigen::Matrix4d& M) {
-  const PointCloud& source = *pairs_[chunk.pair].source;
   const Target& target = *pairs_[chunk.pair].target;
   const PointCloud& tc = target.cloud();
   const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();
@@ -169,16 +194,19 @@ CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const Pair
   GicpBatch gicp;
   for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
     const std::size_t g = chunk.offset + (i - chunk.begin);
-    const Eigen::Vector4d q4 = M * source.points[i];
+    const Eigen::Vector4d q4 = M * source_points_[g];
     if constexpr (kPrevious) {  // exactly costChunk's term: the acceptance test sees the same number
       const std::uint32_t previous = used_[g];
-      if (previous != kNone) out.previous_cost += costTerm<K>(g, (q4 - tc.points[previous]).head<3>(), tc, previous);
+      if (previous != kNone) {
+        out.previous_cost += costTerm<K>(g, q4.head<3>() - targetPoint(g, tc, previous), tc, previous);
+      }
     }
     std::uint32_t j = kNone;
     used_next_[g] = kNone;
     if (!match(target, g, q4, &j)) continue;
+    hold(g, target, j);
     const Eigen::Vector3d q = q4.head<3>();
-    const Eigen::Vector3d r = q - tc.points[j].head<3>();
+    const Eigen::Vector3d r = q - held_[g].point;
     const double d2 = r.squaredNorm();
     if (d2 > max_sq_) continue;  // exact distance just outside the (float) search radius
     if constexpr (K == Residual::kPointToPlane) {
@@ -190,7 +218,7 @@ CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const Pair
       addRow(row, e, sys.H, sys.b);
       sys.cost += e * e;
     } else if constexpr (K == Residual::kGicp) {
-      const Sym3 t = Sym3::load(target.covarianceUpperFloat().data() + 6 * std::size_t{j});
+      const Sym3 t = Sym3::load(held_[g].covariance.data());
       if (source_axis_.empty()) {
         gicp.add(q, r, fusedCovariance(R, source_cov_[g], t), Eigen::Vector3d::Zero(), &weight_next_[g]);
       } else {  // C_s = I − v·vᵀ: R·C_s·Rᵀ = I − (R·v)(R·v)ᵀ
@@ -215,14 +243,13 @@ CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const Pair
 
 template <Residual K>
 double CorrespondenceObjective::costChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) const {
-  const PointCloud& source = *pairs_[chunk.pair].source;
   const PointCloud& tc = pairs_[chunk.pair].target->cloud();
   double cost = 0.0;
   for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
     const std::size_t g = chunk.offset + (i - chunk.begin);
     const std::uint32_t j = used_[g];  // the same matches as the linearisation: the cost is comparable
     if (j == kNone) continue;
-    cost += costTerm<K>(g, (M * source.points[i] - tc.points[j]).head<3>(), tc, j);
+    cost += costTerm<K>(g, (M * source_points_[g]).head<3>() - targetPoint(g, tc, j), tc, j);
   }
   return cost;
 }
@@ -277,13 +304,12 @@ std::optional<LinearSystem> CorrespondenceObjective::measure(const Pose& T, cons
       return part;
     }
     const PairChunk& chunk = chunks_[t];
-    const PointCloud& source = *pairs_[chunk.pair].source;
     const Target& target = *pairs_[chunk.pair].target;
-    for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
-      const Eigen::Vector4d q = M * source.points[i];
+    for (std::size_t g = chunk.offset; g < chunk.offset + (chunk.end - chunk.begin); ++g) {
+      const Eigen::Vector4d q = M * source_points_[g];
       std::uint32_t j = kNone;
-      if (!match(target, chunk.offset + (i - chunk.begin), q, &j)) continue;
-      const double d2 = (q - target.cloud().points[j]).squaredNorm();
+      if (!match(target, g, q, &j)) continue;
+      const double d2 = (q.head<3>() - targetPoint(g, target.cloud(), j)).squaredNorm();
       if (d2 > max_sq_) continue;
       ++part.inliers;
       part.sum_sq_distance += d2;

@@ -1,6 +1,7 @@
 #pragma once
 // Private: nearest-neighbour objectives (point-to-point, point-to-plane, GICP) over one or several
 // (source, target) pairs that share one pose.
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -57,11 +58,14 @@ class CorrespondenceObjective final : public Objective {
                    float* margin) const;
 
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+  // Cube edge of the sources' spatial order (m): a few source voxels, so a run of queries stays local.
+  static constexpr double kOrderCell = 0.5;
   std::span<const SourceTarget> pairs_;
   Residual kind_;
   double max_sq_;
   int num_threads_;
-  std::vector<PairChunk> chunks_;
+  std::vector<PairChunk> chunks_;           // over positions in the spatial order (not source indices)
+  std::vector<Eigen::Vector4d> source_points_;  // every source's points in spatial order, concatenated
   std::vector<std::uint32_t> match_;    // per source point (concatenated): target index or kNone
   std::vector<std::uint32_t> used_;     // the match if the last linearisation used it, else kNone
   std::vector<std::uint32_t> used_next_;  // the same for a pass not yet accepted (swapped in by linearize)
@@ -72,6 +76,21 @@ class CorrespondenceObjective final : public Objective {
   std::vector<Sym3> weight_next_;
   std::optional<LinearSystem> cached_;  // a pass cost() ran at cached_at_, for linearize() there
   Eigen::Matrix4d cached_at_ = Eigen::Matrix4d::Zero();
+  /// Copies of what a residual needs from source point g's current match, kept next to the other
+  /// per-source arrays: passes stream through them in order, and only a changed match reads the target
+  /// (at random, a cache miss per array on a dense map).
+  struct Held {
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    std::array<float, 6> covariance{};  // GICP: the target covariance's upper triangle
+    std::uint32_t index = kNone;
+  };
+  /// The target point j for source point g: from held_ when it holds j.
+  [[nodiscard]] Eigen::Vector3d targetPoint(std::size_t g, const PointCloud& tc, std::uint32_t j) const {
+    return held_[g].index == j ? held_[g].point : Eigen::Vector3d(tc.points[j].head<3>());
+  }
+  /// Makes held_[g] hold target point j.
+  void hold(std::size_t g, const Target& target, std::uint32_t j);
+  std::vector<Held> held_;
   std::vector<Sym3> source_cov_;        // GICP: the sources' covariances, compact, concatenated
   std::vector<Eigen::Vector3d> source_axis_;  // GICP: v with C_s = I − v·vᵀ, when every source has that form
 };
