@@ -124,21 +124,27 @@ bool CorrespondenceObjective::match(const Target& target, std::size_t g, const E
       return found != kNone;
     }
   }
-  if (last == kNone) {
-    // A first search: the point will move too far before the next one for a margin to help (and the
-    // match found here seeds the graph walk next time), so the nearest alone will do, at a smaller bound.
+  if (last == kNone || !target.neighborGraph().empty()) {
+    // A first search, or a walk that could not prove its answer (the point is further from the surface
+    // than the graph vouches for): the point still moves too far before the next pass for a margin to
+    // pay off (the runner-up costs a wider search), so the nearest alone will do, bounded by the last
+    // match. The next pass walks from what is found here.
     Neighbor nb;
     second_[g] = kNone;
     margin_[g] = -1.0F;
-    if (!target.tree().nearest(q, max_sq_, &nb)) return false;
+    if (!target.tree().nearest(q, max_sq_, &nb, last)) {
+      match_[g] = kNone;
+      return false;
+    }
     match_[g] = nb.index;
     *j = nb.index;
     return true;
   }
+  // No graph: the nearest two, so that the margin can spare later passes the tree.
   Neighbor nb[2];
   std::uint32_t hints[2];
   std::size_t num_hints = 0;
-  if (last != kNone) hints[num_hints++] = last;
+  hints[num_hints++] = last;
   if (second_[g] != kNone) hints[num_hints++] = second_[g];
   const std::size_t found = target.tree().knn(q, 2, nb, max_sq_, {hints, num_hints});
   if (found == 0) {
