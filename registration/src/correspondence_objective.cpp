@@ -132,7 +132,7 @@ bool CorrespondenceObjective::match(const Target& target, std::size_t g, const E
     Neighbor nb;
     second_[g] = kNone;
     margin_[g] = -1.0F;
-    if (!target.tree().nearest(q, max_sq_, &nb, last)) {
+    if (!target.tree().nearest(q, max_sq_, &nb, last, last == kNone ? kFirstSearchError : 0.0F)) {
       match_[g] = kNone;
       return false;
     }

@@ -58,6 +58,7 @@ class CorrespondenceObjective final : public Objective {
                    float* margin) const;
 
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+  static constexpr float kFirstSearchError = 0.25F;
   // Cube edge of the sources' spatial order (m): a few source voxels, so a run of queries stays local.
   static constexpr double kOrderCell = 0.5;
   std::span<const SourceTarget> pairs_;

@@ -181,7 +181,8 @@ namespace {
 struct NearestSet {
   std::uint32_t index;
   float d;
-  [[nodiscard]] float bound() const { return d; }
+  float prune;  // 1, or 1 / (1 + ε)² for a (1 + ε)-approximate answer: cells must be that much closer
+  [[nodiscard]] float bound() const { return d * prune; }
   void offer(std::uint32_t i, float dist) {
     if (dist < d) {
       d = dist;
@@ -191,8 +192,8 @@ struct NearestSet {
 };
 }  // namespace
 
-bool KdTree::nearest(const Eigen::Vector4d& q, double max_sq_distance, Neighbor* out,
-                     std::uint32_t hint) const {
+bool KdTree::nearest(const Eigen::Vector4d& q, double max_sq_distance, Neighbor* out, std::uint32_t hint,
+                     float relative_error) const {
   if (points_.empty()) return false;
   const Eigen::Vector4f ql = local(q);
   Neighbor best{std::numeric_limits<std::uint32_t>::max(), toFloat(max_sq_distance)};
@@ -201,7 +202,8 @@ bool KdTree::nearest(const Eigen::Vector4d& q, double max_sq_distance, Neighbor*
     const float d = (points_[h] - ql).squaredNorm();
     if (d < best.sq_distance) best = {h, d};
   }
-  NearestSet set{best.index, best.sq_distance};
+  const float scale = 1.0F + std::max(relative_error, 0.0F);
+  NearestSet set{best.index, best.sq_distance, 1.0F / (scale * scale)};
   search(ql, set);
   if (set.index == std::numeric_limits<std::uint32_t>::max()) return false;
   *out = {index_[set.index], set.d};

@@ -67,6 +67,33 @@ TEST_P(KdTreeTest, MatchesBruteForce) {
 
 INSTANTIATE_TEST_SUITE_P(LeafSizes, KdTreeTest, ::testing::Values(1u, 5u, 12u, 64u));
 
+TEST(KdTree, ApproximateNearestIsWithinTheRelativeErrorAndSkipsWork) {
+  // A dense surface patch and queries well above it: the case the approximate search is for.
+  const auto pts = randomPoints(20000, 5.0, Eigen::Vector3d::Zero(), 4);
+  const KdTree tree(pts);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-4.0, 4.0);
+  int not_exact = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector4d q(u(rng), u(rng), 1.5 + 0.2 * u(rng), 1.0);
+    const double exact = bruteForce(pts, q)[0];
+    for (const float eps : {0.25F, 1.0F}) {
+      Neighbor nn;
+      ASSERT_TRUE(tree.nearest(q, 1e30, &nn, KdTree::kNoHint, eps));
+      const double d2 = (pts[nn.index] - q).head<3>().squaredNorm();
+      EXPECT_GE(d2, exact * (1.0 - 1e-5));
+      EXPECT_LE(d2, exact * (1.0 + eps) * (1.0 + eps) * (1.0 + 1e-5));
+      if (d2 > exact * (1.0 + 1e-5)) ++not_exact;
+    }
+    // The range still holds: nothing beyond it, even approximately.
+    Neighbor nn;
+    EXPECT_FALSE(tree.nearest(q, exact * 0.999, &nn, KdTree::kNoHint, 1.0F));
+    ASSERT_TRUE(tree.nearest(q, 1e30, &nn, KdTree::kNoHint, 0.0F));
+    EXPECT_NEAR(nn.sq_distance, exact, 1e-4 * exact);
+  }
+  EXPECT_GT(not_exact, 0);  // it does take the shortcut somewhere (else the option would do nothing)
+}
+
 TEST(KdTree, EmptyTinyAndDuplicates) {
   const KdTree empty;
   Neighbor nn;

@@ -51,8 +51,11 @@ class KdTree {
 
   /// The nearest point closer than sqrt(max_sq_distance); false when there is none.
   /// `hint` (an index probably close to q, e.g. last iteration's match) only speeds the search up.
-  bool nearest(const Eigen::Vector4d& q, double max_sq_distance, Neighbor* out,
-               std::uint32_t hint = kNoHint) const;
+  /// With relative_error ε > 0 the answer may instead be any point at most (1 + ε) times as far as the
+  /// nearest (and still within range): cells are skipped sooner, which pays for queries far from the
+  /// points (a dense map around a source not yet aligned), where the ball to search holds many leaves.
+  bool nearest(const Eigen::Vector4d& q, double max_sq_distance, Neighbor* out, std::uint32_t hint = kNoHint,
+               float relative_error = 0.0F) const;
 
   /// Original index of the i-th point in leaf order. A cloud stored in this order makes spatially close
   /// queries touch close memory; see useLeafOrderIndices().
