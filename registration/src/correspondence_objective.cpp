@@ -99,8 +99,10 @@ bool CorrespondenceObjective::graphSearch(const Target& target, std::uint32_t st
       *margin = 0.5F * (std::min(std::sqrt(second2), limit) - best_d) - slack;
       return true;
     }
-    if (best == c) return false;
-    c = best;  // walk towards q and try again from there
+    // Walk towards q and try again from there, unless that point cannot vouch for anything as close as
+    // itself (q is further off the surface than its neighbour list reaches): the tree decides sooner.
+    if (best == c || !(graph.radius[best] - best_d - slack > 0.0F)) return false;
+    c = best;
   }
   return false;
 }
