@@ -14,19 +14,15 @@
 #include <pcl/registration/ndt.h>
 
 #include <algorithm>
-#include <chrono>
-#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
-#include <memory>
-#include <random>
 #include <string>
-#include <valgrind/callgrind.h>
 
-#include "rigcal/core/pcd_io.hpp"
+#include "registration_bench_data.hpp"
+#include "registration_profile.hpp"
 #include "rigcal/registration/covariance.hpp"
 #include "rigcal/registration/gicp.hpp"
 #include "rigcal/registration/icp.hpp"
@@ -37,105 +33,31 @@ namespace {
 
 using namespace rigcal;
 using namespace rigcal::registration;
-using PclCloud = pcl::PointCloud<pcl::PointXYZ>;
-
-struct Scenario {
-  std::string name;
-  std::unique_ptr<Target> target;  // everything: tree, covariances + graph, NDT grid 1.0
-  PclCloud::Ptr pcl_target;
-};
-
-struct Data {
-  PointCloud raw;
-  PointCloud source;       // positions only
-  PointCloud source_cov;   // with covariances (for "align only")
-  PclCloud::Ptr pcl_source;
-  Pose truth;
-  Scenario scan, map;
-};
-std::unique_ptr<Data> g_data;
-
-PclCloud::Ptr toPcl(const PointCloud& c) {
-  auto out = std::make_shared<PclCloud>();
-  out->reserve(c.size());
-  for (const auto& p : c.points) out->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
-  return out;
-}
-
-PointCloud cropped(const PointCloud& c, double range) {
-  PointCloud out;
-  for (const auto& p : c.points) {
-    if (p.head<3>().norm() < range) out.points.push_back(p);
-  }
-  return out;
-}
-
-void load(const std::filesystem::path& path, const std::filesystem::path& other) {
-  auto d = std::make_unique<Data>();
-  d->raw = fromTable(readPcd(path));
-  d->truth = fromXyzRpy({0.3, -0.2, 0.05, deg2rad(1.0), deg2rad(-0.5), deg2rad(3.0)});
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0.0, 0.01);
-  PointCloud moved = transformed(d->raw, d->truth.inverse());
-  for (auto& p : moved.points) p.head<3>() += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
-  d->source = voxelDownsample(cropped(moved, 22.0), 0.25);
-  d->source_cov = d->source;
-  estimateCovariances(d->source_cov);
-  d->pcl_source = toPcl(d->source);
-
-  TargetOptions options;
-  options.normals_and_covariances = true;
-  options.ndt_resolutions = {1.0};
-  options.num_threads = 2;
-  const PointCloud scan = voxelDownsample(cropped(d->raw, 22.0), 0.25);
-  d->scan = {"s2s", std::make_unique<Target>(scan, options), toPcl(scan)};
-  // Densify along scan lines: midpoints of consecutive returns closer than 0.3 m lie on the surfaces.
-  PointCloud dense = d->raw;
-  for (std::size_t i = 1; i < d->raw.size(); ++i) {
-    const Eigen::Vector4d a = d->raw.points[i - 1], b = d->raw.points[i];
-    if ((a - b).norm() < 0.3) dense.points.push_back(0.5 * (a + b));
-  }
-  PointCloud map = voxelDownsample(dense, 0.05);
-  for (const auto& p : fromTable(readPcd(other)).points) map.points.push_back(p + Eigen::Vector4d(600.0, 0, 0, 0));
-  d->map = {"s2m", std::make_unique<Target>(map, options), toPcl(map)};
-  std::printf("data: raw %zu, source %zu, scan target %zu, map target %zu points\n", d->raw.size(),
-              d->source.size(), scan.size(), map.size());
-  g_data = std::move(d);
-}
+using namespace rigcal::bench;
 
 void setErrors(benchmark::State& state, const Pose& estimate) {
-  const Pose e = g_data->truth.inverse() * estimate;
+  const Pose e = data().truth.inverse() * estimate;
   state.counters["t_err_mm"] = e.translation().norm() * 1e3;
   state.counters["r_err_deg"] = rad2deg(rotationAngle(e));
-}
-
-template <class P>
-P common(int threads) {
-  P p;
-  p.num_threads = threads;
-  p.max_iterations = 64;
-  p.transformation_epsilon = 1e-4;
-  p.rotation_epsilon = 1e-4;
-  return p;
 }
 
 // ---- ours ------------------------------------------------------------------------------------------------
 void oursGicp(benchmark::State& state, const Scenario* s, bool with_source_covariances) {
   const auto params = [&] {
-    auto p = common<GicpParams>(static_cast<int>(state.range(0)));
+    auto p = commonParams<GicpParams>(static_cast<int>(state.range(0)));
     p.max_correspondence_distance = 1.0;
     return p;
   }();
   RegistrationResult r;
   for (auto _ : state) {
     if (with_source_covariances) {
-      PointCloud src = g_data->source;
+      PointCloud src = data().source;
       CovarianceOptions co;
       co.num_threads = params.num_threads;
       estimateCovariances(src, co);
       r = alignGicp(*s->target, src, Pose::Identity(), params);
     } else {
-      r = alignGicp(*s->target, g_data->source_cov, Pose::Identity(), params);
+      r = alignGicp(*s->target, data().source_cov, Pose::Identity(), params);
     }
   }
   setErrors(state, r.T_target_source);
@@ -143,19 +65,19 @@ void oursGicp(benchmark::State& state, const Scenario* s, bool with_source_covar
 }
 
 void oursNdt(benchmark::State& state, const Scenario* s) {
-  auto params = common<NdtParams>(static_cast<int>(state.range(0)));
+  auto params = commonParams<NdtParams>(static_cast<int>(state.range(0)));
   RegistrationResult r;
-  for (auto _ : state) r = alignNdt(*s->target, g_data->source, Pose::Identity(), params);
+  for (auto _ : state) r = alignNdt(*s->target, data().source, Pose::Identity(), params);
   setErrors(state, r.T_target_source);
   state.counters["iterations"] = r.iterations;
 }
 
 void oursIcp(benchmark::State& state, const Scenario* s, IcpMethod method) {
-  auto params = common<IcpParams>(static_cast<int>(state.range(0)));
+  auto params = commonParams<IcpParams>(static_cast<int>(state.range(0)));
   params.method = method;
   params.max_correspondence_distance = 1.0;
   RegistrationResult r;
-  for (auto _ : state) r = alignIcp(*s->target, g_data->source, Pose::Identity(), params);
+  for (auto _ : state) r = alignIcp(*s->target, data().source, Pose::Identity(), params);
   setErrors(state, r.T_target_source);
   state.counters["iterations"] = r.iterations;
 }
@@ -164,11 +86,11 @@ void oursIcp(benchmark::State& state, const Scenario* s, IcpMethod method) {
 template <class Reg>
 void runPcl(benchmark::State& state, Reg& reg, const Scenario* s) {
   reg.setInputTarget(s->pcl_target);
-  reg.setInputSource(g_data->pcl_source);
+  reg.setInputSource(data().pcl_source);
   PclCloud out;
   reg.align(out);  // warm-up: builds and caches the target side (tree, covariances, grid), like our Target
   for (auto _ : state) {
-    reg.setInputSource(g_data->pcl_source);  // source-side work (GICP covariances) is redone per align
+    reg.setInputSource(data().pcl_source);  // source-side work (GICP covariances) is redone per align
     reg.align(out);
   }
   setErrors(state, Pose(reg.getFinalTransformation().template cast<double>()));
@@ -207,10 +129,10 @@ void pclIcp(benchmark::State& state, const Scenario* s) {
 // ---- building blocks -------------------------------------------------------------------------------------
 void oursNearest(benchmark::State& state, const Scenario* s) {
   const KdTree& tree = s->target->tree();
-  const Eigen::Matrix4d M = g_data->truth.matrix();
+  const Eigen::Matrix4d M = data().truth.matrix();
   std::size_t found = 0;
   for (auto _ : state) {
-    for (const auto& p : g_data->source.points) {
+    for (const auto& p : data().source.points) {
       Neighbor nb;
       found += tree.nearest(M * p, 1.0, &nb);
     }
@@ -221,12 +143,12 @@ void oursNearest(benchmark::State& state, const Scenario* s) {
 void pclNearest(benchmark::State& state, const Scenario* s) {
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
   tree.setInputCloud(s->pcl_target);
-  const Eigen::Matrix4d M = g_data->truth.matrix();
+  const Eigen::Matrix4d M = data().truth.matrix();
   std::vector<int> idx(1);
   std::vector<float> d2(1);
   std::size_t found = 0;
   for (auto _ : state) {
-    for (const auto& p : g_data->source.points) {
+    for (const auto& p : data().source.points) {
       const Eigen::Vector4d q = M * p;
       const int n = tree.nearestKSearch(pcl::PointXYZ(float(q.x()), float(q.y()), float(q.z())), 1, idx, d2);
       found += n > 0 && d2[0] < 1.0F;  // the same question: the nearest point within 1 m
@@ -251,11 +173,11 @@ void pclTreeBuild(benchmark::State& state, const Scenario* s) {
 // like-for-like timing; the 0.1 m row shows the failure.
 void oursVoxel(benchmark::State& state, double leaf) {
   std::size_t n = 0;
-  for (auto _ : state) n = voxelDownsample(g_data->raw, leaf).size();
+  for (auto _ : state) n = voxelDownsample(data().raw, leaf).size();
   state.counters["points_out"] = static_cast<double>(n);
 }
 void pclVoxel(benchmark::State& state, double leaf) {
-  const PclCloud::Ptr raw = toPcl(g_data->raw);
+  const PclCloud::Ptr raw = toPcl(data().raw);
   PclCloud out;
   const auto f = static_cast<float>(leaf);
   for (auto _ : state) {
@@ -352,68 +274,6 @@ void printTable() {
   }
 }
 
-// `registration_bench --profile CASE [N]`: runs one case N times (default 5) with callgrind's
-// instrumentation on only around the alignments, so `valgrind --tool=callgrind --instr-atstart=no` counts
-// exactly their instructions (machine-independent, unlike times on this shared machine). CASE is
-// s2s-gicp-cov, s2s-gicp, s2m-gicp-cov, s2m-gicp or cov (source covariances alone).
-int profile(const std::string& which, int runs) {
-  const Scenario* s = which.rfind("s2m", 0) == 0 ? &g_data->map : &g_data->scan;
-  // s2s-target / s2m-target: a Target from positions only (tree, covariances, neighbour graph; no NDT
-  // grid), 1 thread: what the mapper's local-map build does at each keyframe.
-  if (which.find("-target") != std::string::npos) {
-    PointCloud positions;
-    positions.points = s->target->cloud().points;
-    TargetOptions target_options;
-    target_options.normals_and_covariances = true;
-    std::vector<double> target_ms;
-    std::size_t graph_size = 0;
-    for (int i = 0; i < runs; ++i) {
-      PointCloud copy = positions;
-      const auto start = std::chrono::steady_clock::now();
-      CALLGRIND_START_INSTRUMENTATION;
-      const Target t(std::move(copy), target_options);
-      CALLGRIND_STOP_INSTRUMENTATION;
-      target_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-      graph_size = t.neighborGraph().neighbors.size();
-    }
-    std::sort(target_ms.begin(), target_ms.end());
-    std::printf("%s: %zu points, %d runs, median %.2f ms, min %.2f ms (graph entries %zu)\n", which.c_str(),
-                positions.size(), runs, target_ms[target_ms.size() / 2], target_ms[0], graph_size);
-    return 0;
-  }
-  const bool with_cov = which == "cov" || which.find("-cov") != std::string::npos;
-  GicpParams params = common<GicpParams>(1);
-  params.max_correspondence_distance = 1.0;
-  RegistrationResult r;
-  std::vector<double> ms, cpu_ms;
-  const auto thread_cpu_ms = [] {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-  };
-  for (int i = 0; i < runs; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    const double cpu_start = thread_cpu_ms();
-    CALLGRIND_START_INSTRUMENTATION;
-    if (with_cov) {
-      PointCloud src = g_data->source;
-      estimateCovariances(src);
-      if (which != "cov") r = alignGicp(*s->target, src, Pose::Identity(), params);
-    } else {
-      r = alignGicp(*s->target, g_data->source_cov, Pose::Identity(), params);
-    }
-    CALLGRIND_STOP_INSTRUMENTATION;
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-    cpu_ms.push_back(thread_cpu_ms() - cpu_start);
-  }
-  std::sort(ms.begin(), ms.end());
-  std::sort(cpu_ms.begin(), cpu_ms.end());
-  const Pose e = g_data->truth.inverse() * r.T_target_source;
-  std::printf("%s: %d runs, median %.2f ms (CPU %.2f), min %.2f ms (CPU %.2f); %d iterations, error %.3f mm / %.5f deg\n",
-              which.c_str(), runs, ms[ms.size() / 2], cpu_ms[cpu_ms.size() / 2], ms[0], cpu_ms[0], r.iterations, e.translation().norm() * 1e3, rad2deg(rotationAngle(e)));
-  return 0;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -428,18 +288,18 @@ int main(int argc, char** argv) {
     }
   }
   if (argc >= 3 && std::string(argv[1]) == "--profile") {
-    load(scan, other);
-    return profile(argv[2], argc >= 4 ? std::atoi(argv[3]) : 5);
+    loadRegistrationData(scan, other);
+    return registrationProfile(argv[2], argc >= 4 ? std::atoi(argv[3]) : 5);
   }
   benchmark::Initialize(&argc, argv);
-  load(scan, other);
+  loadRegistrationData(scan, other);
   const auto stats = [](benchmark::internal::Benchmark* b, int reps) {
     b->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(reps);
     b->ComputeStatistics("p99", percentile99)->ReportAggregatesOnly(true);
   };
-  for (Scenario* s : {&g_data->scan, &g_data->map}) {
+  for (const Scenario* s : {&data().scan, &data().map}) {
     const std::string n = s->name + "/";
-    const int pcl_reps = s == &g_data->scan ? 5 : 3;
+    const int pcl_reps = s == &data().scan ? 5 : 3;
     for (const int t : {1, 2}) {
       const std::string th = "/ours/threads:" + std::to_string(t);
       stats(benchmark::RegisterBenchmark((n + "GICP+cov" + th).c_str(), oursGicp, s, true)->Arg(t), 20);
