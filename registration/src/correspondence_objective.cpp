@@ -171,7 +171,7 @@ void CorrespondenceObjective::hold(std::size_t g, const Target& target, std::uin
   h.point = target.cloud().points[j].head<3>();
   if (kind_ == Residual::kGicp) {
     const float* c = target.covarianceUpperFloat().data() + 6 * std::size_t{j};
-    std::copy(c, c + 6, h.covariance.begin());
+    for (std::size_t e = 0; e < 6; ++e) h.covariance[e] = c[e];  // (std::copy calls memmove here)
   }
 }
 
