@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 
+#include "candidate_scan.hpp"
 #include "rigcal/registration/parallel.hpp"
+#include "top_k.hpp"
 #include "voxel_hash.hpp"
 
 namespace rigcal::registration::detail {
@@ -64,32 +66,26 @@ constexpr std::array<std::array<std::int64_t, 3>, 27> kBlockOrder = [] {
   return out;
 }();
 
-// The k best of one query, sorted, closest first.
-struct TopK {
-  Neighbor* out;
-  std::size_t k;
-  std::size_t count = 0;
-  float worst;  // distance a candidate must beat: the proof's limit until k are found
-
-  void offer(std::uint32_t i, float d) {
-    if (!(d < worst)) return;
-    std::size_t pos = count < k ? count++ : k - 1;
-    while (pos > 0 && out[pos - 1].sq_distance > d) {
-      out[pos] = out[pos - 1];
-      --pos;
-    }
-    out[pos] = {i, d};
-    if (count == k) worst = out[k - 1].sq_distance;
-  }
+// A proven query of the cell being searched: its k nearest are among the block's candidates, so any other
+// query q of the cell has k candidates within |q − anchor| + (anchor's k-th distance). That bound is
+// usually much tighter than the proof's: fewer candidates are offered, none that could be the answer is
+// turned away. Only the proof's bound decides which answers count as proven.
+struct Anchor {
+  float x, y, z;  // as the query's own coordinates in the block
+  float kth;      // its k-th squared distance, as the scan computed it
 };
+constexpr std::size_t kMaxAnchors = 4;
 
-// A plain loop over restrict-qualified arrays: the compiler vectorises it.
-void squaredDistances(const float* __restrict xs, const float* __restrict ys, const float* __restrict zs, std::size_t m,
-                      float qx, float qy, float qz, float* __restrict d2) {
-  for (std::size_t j = 0; j < m; ++j) {
-    const float ex = xs[j] - qx, ey = ys[j] - qy, ez = zs[j] - qz;
-    d2[j] = ex * ex + ey * ey + ez * ez;
+// min over the anchors of (|q − a| + √kth)², widened for the float rounding of the distances it bounds
+// (relative error of a float squared distance: < 5 · 2⁻²⁴; underflow: the absolute term).
+float anchorBound(const std::vector<Anchor>& anchors, float qx, float qy, float qz) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Anchor& a : anchors) {
+    const double ex = double(qx) - double(a.x), ey = double(qy) - double(a.y), ez = double(qz) - double(a.z);
+    const double reach = std::sqrt(ex * ex + ey * ey + ez * ez) + std::sqrt(double(a.kth));
+    best = std::min(best, reach * reach);
   }
+  return static_cast<float>(best * (1.0 + 1e-5) + 1e-30);
 }
 
 }  // namespace
@@ -155,9 +151,11 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
   std::vector<std::uint8_t> proven(n, 0);
   const double block = 1.5 * grid.h;  // half-width of the 3x3x3 block around a cell's centre
 
+  const CandidateScan scan = candidateScan(fastestCandidateScanPath());
   parallelFor(chunkCount(cells, kCellsPerTask), num_threads, [&](std::size_t task) {
-    std::vector<float> xs, ys, zs, d2;
+    std::vector<float> xs, ys, zs;
     std::vector<std::uint32_t> ids;
+    std::vector<Anchor> anchors;
     const std::size_t first = task * kCellsPerTask;
     const std::size_t last = std::min(cells, first + kCellsPerTask);
     for (std::size_t c = first; c < last; ++c) {
@@ -175,12 +173,12 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
         ++num_runs;
       }
       if (tree_at_hand && m > kMaxCandidatesPerK * k) continue;  // too crowded: unproven, for the tree
-      if (xs.size() < m) {
-        xs.resize(m);
-        ys.resize(m);
-        zs.resize(m);
-        d2.resize(m);
-        ids.resize(m);
+      const std::size_t padded = (m + kCandidateLanes - 1) / kCandidateLanes * kCandidateLanes;
+      if (xs.size() < padded) {
+        xs.resize(padded);
+        ys.resize(padded);
+        zs.resize(padded);
+        ids.resize(padded);
       }
       std::size_t o = 0;
       for (std::size_t r = 0; r < num_runs; ++r) {
@@ -193,21 +191,29 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
         }
         o += e - b;
       }
+      constexpr float kFar = std::numeric_limits<float>::infinity();
+      std::fill(xs.begin() + m, xs.begin() + padded, kFar);
+      std::fill(ys.begin() + m, ys.begin() + padded, kFar);
+      std::fill(zs.begin() + m, zs.begin() + padded, kFar);
+      const CandidateBlock candidates{xs.data(), ys.data(), zs.data(), ids.data(), padded};
+      anchors.clear();
       for (std::uint32_t s = begin[c]; s < begin[c + 1]; ++s) {
         const std::uint32_t q = order[s];
         const Eigen::Vector3d local = points[q].head<3>() - centre;
         const float qx = static_cast<float>(local.x()), qy = static_cast<float>(local.y()),
                     qz = static_cast<float>(local.z());
-        squaredDistances(xs.data(), ys.data(), zs.data(), m, qx, qy, qz, d2.data());
         // Anything outside the block is at least `margin` away: only candidates closer than that can be
         // proven members (with a relative slack for the float distances), so the rest are never offered.
         const double margin = block - local.cwiseAbs().maxCoeff();
-        TopK top{out->neighbors.data() + q * k, k, 0, static_cast<float>(margin * margin * (1.0 - 1e-5))};
-        for (std::size_t j = 0; j < m; ++j) {
-          if (d2[j] < top.worst) top.offer(ids[j], d2[j]);
-        }
+        const float proof_bound = static_cast<float>(margin * margin * (1.0 - 1e-5));
+        TopK top{out->neighbors.data() + q * k, k, 0, std::min(proof_bound, anchorBound(anchors, qx, qy, qz))};
+        scan(candidates, qx, qy, qz, top);
         out->count[q] = static_cast<std::uint32_t>(top.count);
         proven[q] = top.count == k;
+        if (proven[q]) {
+          if (anchors.size() == kMaxAnchors) anchors.erase(anchors.begin());
+          anchors.push_back({qx, qy, qz, top.worst});
+        }
       }
     }
   });
