@@ -69,23 +69,19 @@ constexpr std::array<std::array<std::int64_t, 3>, 27> kBlockOrder = [] {
 // A proven query of the cell being searched: its k nearest are among the block's candidates, so any other
 // query q of the cell has k candidates within |q − anchor| + (anchor's k-th distance). That bound is
 // usually much tighter than the proof's: fewer candidates are offered, none that could be the answer is
-// turned away. Only the proof's bound decides which answers count as proven.
+// turned away. Only the proof's bound decides which answers count as proven. (The cell's latest proven
+// query: the closest of several is not worth its cost, measured.)
 struct Anchor {
   float x, y, z;  // as the query's own coordinates in the block
-  float kth;      // its k-th squared distance, as the scan computed it
+  float kth;      // its k-th squared distance, as the scan computed it; +inf: no anchor yet
 };
-constexpr std::size_t kMaxAnchors = 4;
 
-// min over the anchors of (|q − a| + √kth)², widened for the float rounding of the distances it bounds
-// (relative error of a float squared distance: < 5 · 2⁻²⁴; underflow: the absolute term).
-float anchorBound(const std::vector<Anchor>& anchors, float qx, float qy, float qz) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const Anchor& a : anchors) {
-    const double ex = double(qx) - double(a.x), ey = double(qy) - double(a.y), ez = double(qz) - double(a.z);
-    const double reach = std::sqrt(ex * ex + ey * ey + ez * ez) + std::sqrt(double(a.kth));
-    best = std::min(best, reach * reach);
-  }
-  return static_cast<float>(best * (1.0 + 1e-5) + 1e-30);
+// (|q − a| + √kth)², widened for the float rounding of the distances it bounds (relative error of a
+// float squared distance: < 5 · 2⁻²⁴; underflow: the absolute term).
+float anchorBound(const Anchor& a, float qx, float qy, float qz) {
+  const double ex = double(qx) - double(a.x), ey = double(qy) - double(a.y), ez = double(qz) - double(a.z);
+  const double reach = std::sqrt(ex * ex + ey * ey + ez * ez) + std::sqrt(double(a.kth));
+  return static_cast<float>(reach * reach * (1.0 + 1e-5) + 1e-30);
 }
 
 }  // namespace
@@ -155,7 +151,6 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
   parallelFor(chunkCount(cells, kCellsPerTask), num_threads, [&](std::size_t task) {
     std::vector<float> xs, ys, zs;
     std::vector<std::uint32_t> ids;
-    std::vector<Anchor> anchors;
     const std::size_t first = task * kCellsPerTask;
     const std::size_t last = std::min(cells, first + kCellsPerTask);
     for (std::size_t c = first; c < last; ++c) {
@@ -196,7 +191,7 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
       std::fill(ys.begin() + m, ys.begin() + padded, kFar);
       std::fill(zs.begin() + m, zs.begin() + padded, kFar);
       const CandidateBlock candidates{xs.data(), ys.data(), zs.data(), ids.data(), padded};
-      anchors.clear();
+      Anchor anchor{0.0F, 0.0F, 0.0F, std::numeric_limits<float>::infinity()};
       for (std::uint32_t s = begin[c]; s < begin[c + 1]; ++s) {
         const std::uint32_t q = order[s];
         const Eigen::Vector3d local = points[q].head<3>() - centre;
@@ -206,14 +201,11 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
         // proven members (with a relative slack for the float distances), so the rest are never offered.
         const double margin = block - local.cwiseAbs().maxCoeff();
         const float proof_bound = static_cast<float>(margin * margin * (1.0 - 1e-5));
-        TopK top{out->neighbors.data() + q * k, k, 0, std::min(proof_bound, anchorBound(anchors, qx, qy, qz))};
+        TopK top{out->neighbors.data() + q * k, k, 0, std::min(proof_bound, anchorBound(anchor, qx, qy, qz))};
         scan(candidates, qx, qy, qz, top);
         out->count[q] = static_cast<std::uint32_t>(top.count);
         proven[q] = top.count == k;
-        if (proven[q]) {
-          if (anchors.size() == kMaxAnchors) anchors.erase(anchors.begin());
-          anchors.push_back({qx, qy, qz, top.worst});
-        }
+        if (proven[q]) anchor = {qx, qy, qz, top.worst};
       }
     }
   });
