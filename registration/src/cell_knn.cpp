@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 
+#include "candidate_scan.hpp"
 #include "rigcal/registration/parallel.hpp"
+#include "top_k.hpp"
 #include "voxel_hash.hpp"
 
 namespace rigcal::registration::detail {
@@ -64,32 +66,31 @@ constexpr std::array<std::array<std::int64_t, 3>, 27> kBlockOrder = [] {
   return out;
 }();
 
-// The k best of one query, sorted, closest first.
-struct TopK {
-  Neighbor* out;
-  std::size_t k;
-  std::size_t count = 0;
-  float worst;  // distance a candidate must beat: the proof's limit until k are found
-
-  void offer(std::uint32_t i, float d) {
-    if (!(d < worst)) return;
-    std::size_t pos = count < k ? count++ : k - 1;
-    while (pos > 0 && out[pos - 1].sq_distance > d) {
-      out[pos] = out[pos - 1];
-      --pos;
-    }
-    out[pos] = {i, d};
-    if (count == k) worst = out[k - 1].sq_distance;
-  }
+// A point the 3x3x3 block could not prove, during the shell search.
+struct ShellQuery {
+  std::uint32_t q;
+  Eigen::Vector3d p;
+  double inner;  // from the point to its own cell's faces
+  TopK top;
+  bool done = false;
 };
 
-// A plain loop over restrict-qualified arrays: the compiler vectorises it.
-void squaredDistances(const float* __restrict xs, const float* __restrict ys, const float* __restrict zs, std::size_t m,
-                      float qx, float qy, float qz, float* __restrict d2) {
-  for (std::size_t j = 0; j < m; ++j) {
-    const float ex = xs[j] - qx, ey = ys[j] - qy, ez = zs[j] - qz;
-    d2[j] = ex * ex + ey * ey + ez * ez;
-  }
+// A proven query of the cell being searched: its k nearest are among the block's candidates, so any other
+// query q of the cell has k candidates within |q − anchor| + (anchor's k-th distance). That bound is
+// usually much tighter than the proof's: fewer candidates are offered, none that could be the answer is
+// turned away. Only the proof's bound decides which answers count as proven. (The cell's latest proven
+// query: the closest of several is not worth its cost, measured.)
+struct Anchor {
+  float x, y, z;  // as the query's own coordinates in the block
+  float kth;      // its k-th squared distance, as the scan computed it; +inf: no anchor yet
+};
+
+// (|q − a| + √kth)², widened for the float rounding of the distances it bounds (relative error of a
+// float squared distance: < 5 · 2⁻²⁴; underflow: the absolute term).
+float anchorBound(const Anchor& a, float qx, float qy, float qz) {
+  const double ex = double(qx) - double(a.x), ey = double(qy) - double(a.y), ez = double(qz) - double(a.z);
+  const double reach = std::sqrt(ex * ex + ey * ey + ez * ez) + std::sqrt(double(a.kth));
+  return static_cast<float>(reach * reach * (1.0 + 1e-5) + 1e-30);
 }
 
 }  // namespace
@@ -155,8 +156,9 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
   std::vector<std::uint8_t> proven(n, 0);
   const double block = 1.5 * grid.h;  // half-width of the 3x3x3 block around a cell's centre
 
+  const CandidateScan scan = candidateScan(fastestCandidateScanPath());
   parallelFor(chunkCount(cells, kCellsPerTask), num_threads, [&](std::size_t task) {
-    std::vector<float> xs, ys, zs, d2;
+    std::vector<float> xs, ys, zs;
     std::vector<std::uint32_t> ids;
     const std::size_t first = task * kCellsPerTask;
     const std::size_t last = std::min(cells, first + kCellsPerTask);
@@ -175,12 +177,12 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
         ++num_runs;
       }
       if (tree_at_hand && m > kMaxCandidatesPerK * k) continue;  // too crowded: unproven, for the tree
-      if (xs.size() < m) {
-        xs.resize(m);
-        ys.resize(m);
-        zs.resize(m);
-        d2.resize(m);
-        ids.resize(m);
+      const std::size_t padded = (m + kCandidateLanes - 1) / kCandidateLanes * kCandidateLanes;
+      if (xs.size() < padded) {
+        xs.resize(padded);
+        ys.resize(padded);
+        zs.resize(padded);
+        ids.resize(padded);
       }
       std::size_t o = 0;
       for (std::size_t r = 0; r < num_runs; ++r) {
@@ -193,21 +195,26 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
         }
         o += e - b;
       }
+      constexpr float kFar = std::numeric_limits<float>::infinity();
+      std::fill(xs.begin() + m, xs.begin() + padded, kFar);
+      std::fill(ys.begin() + m, ys.begin() + padded, kFar);
+      std::fill(zs.begin() + m, zs.begin() + padded, kFar);
+      const CandidateBlock candidates{xs.data(), ys.data(), zs.data(), ids.data(), padded};
+      Anchor anchor{0.0F, 0.0F, 0.0F, std::numeric_limits<float>::infinity()};
       for (std::uint32_t s = begin[c]; s < begin[c + 1]; ++s) {
         const std::uint32_t q = order[s];
         const Eigen::Vector3d local = points[q].head<3>() - centre;
         const float qx = static_cast<float>(local.x()), qy = static_cast<float>(local.y()),
                     qz = static_cast<float>(local.z());
-        squaredDistances(xs.data(), ys.data(), zs.data(), m, qx, qy, qz, d2.data());
         // Anything outside the block is at least `margin` away: only candidates closer than that can be
         // proven members (with a relative slack for the float distances), so the rest are never offered.
         const double margin = block - local.cwiseAbs().maxCoeff();
-        TopK top{out->neighbors.data() + q * k, k, 0, static_cast<float>(margin * margin * (1.0 - 1e-5))};
-        for (std::size_t j = 0; j < m; ++j) {
-          if (d2[j] < top.worst) top.offer(ids[j], d2[j]);
-        }
+        const float proof_bound = static_cast<float>(margin * margin * (1.0 - 1e-5));
+        TopK top{out->neighbors.data() + q * k, k, 0, std::min(proof_bound, anchorBound(anchor, qx, qy, qz))};
+        scan(candidates, qx, qy, qz, top);
         out->count[q] = static_cast<std::uint32_t>(top.count);
         proven[q] = top.count == k;
+        if (proven[q]) anchor = {qx, qy, qz, top.worst};
       }
     }
   });
@@ -219,40 +226,63 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
     out->unproven = std::move(pending);
     return true;
   }
-  // The few left (sparse places, or near a block face) look further, one point at a time, shell by
-  // shell: after the cells within r of its own, the k best so far are the answer once the k-th is closer
-  // than the faces of that (2r+1)³ block. What even r = kMaxRing cannot prove goes further below.
+  // The few left (sparse places, or near a block face) look further, shell by shell: after the cells
+  // within r of its own, a point's k best so far are the answer once the k-th is closer than the faces of
+  // that (2r+1)³ block. The pending points of one cell share the look-ups of its shells; each still sees
+  // the candidates in the same order as alone. What even r = kMaxRing cannot prove goes further below.
   {
-    const std::size_t m = pending.size();
-    parallelFor(chunkCount(m, kDefaultChunk), num_threads, [&](std::size_t task) {
-      for (std::size_t u = task * kDefaultChunk; u < std::min(m, (task + 1) * kDefaultChunk); ++u) {
-        const std::uint32_t q = pending[u];
-        const VoxelCoord cc = coords[cell_of[q]];
-        const double qx = points[q].x(), qy = points[q].y(), qz = points[q].z();
-        const double inner = grid.h * 0.5 - (points[q].head<3>() - grid.centre(cc)).cwiseAbs().maxCoeff();
-        TopK top{out->neighbors.data() + q * k, k, 0, std::numeric_limits<float>::infinity()};
-        for (std::int64_t r = 0; r <= kMaxRing; ++r) {
+    std::vector<std::uint32_t> by_cell = pending;  // ascending: stable by point within a cell
+    std::stable_sort(by_cell.begin(), by_cell.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return cell_of[a] < cell_of[b]; });
+    std::vector<std::size_t> group_begin;
+    for (std::size_t u = 0; u < by_cell.size(); ++u) {
+      if (u == 0 || cell_of[by_cell[u]] != cell_of[by_cell[u - 1]]) group_begin.push_back(u);
+    }
+    const std::size_t groups = group_begin.size();
+    group_begin.push_back(by_cell.size());
+    constexpr std::size_t kGroupsPerTask = 64;
+    parallelFor(chunkCount(groups, kGroupsPerTask), num_threads, [&](std::size_t task) {
+      std::vector<ShellQuery> queries;
+      for (std::size_t g = task * kGroupsPerTask; g < std::min(groups, (task + 1) * kGroupsPerTask); ++g) {
+        const VoxelCoord cc = coords[cell_of[by_cell[group_begin[g]]]];
+        queries.clear();
+        for (std::size_t u = group_begin[g]; u < group_begin[g + 1]; ++u) {
+          const std::uint32_t q = by_cell[u];
+          queries.push_back({q, points[q].head<3>(),
+                             grid.h * 0.5 - (points[q].head<3>() - grid.centre(cc)).cwiseAbs().maxCoeff(),
+                             TopK{out->neighbors.data() + q * k, k, 0, std::numeric_limits<float>::infinity()}});
+        }
+        std::size_t open = queries.size();
+        for (std::int64_t r = 0; r <= kMaxRing && open > 0; ++r) {
           for (std::int64_t dz = -r; dz <= r; ++dz) {
             for (std::int64_t dy = -r; dy <= r; ++dy) {
               const bool face = std::abs(dz) == r || std::abs(dy) == r;
               for (std::int64_t dx = -r; dx <= r; dx += face ? 1 : 2 * r) {  // inside rows: the two ends only
                 const std::uint32_t other = map.find({cc.x + dx, cc.y + dy, cc.z + dz});
                 if (other == VoxelIndexMap::kNone) continue;
-                for (std::uint32_t t = begin[other]; t < begin[other + 1]; ++t) {
-                  const double ex = sx[t] - qx, ey = sy[t] - qy, ez = sz[t] - qz;
-                  const auto d = static_cast<float>(ex * ex + ey * ey + ez * ez);
-                  if (d < top.worst) top.offer(order[t], d);
+                for (ShellQuery& sq : queries) {
+                  if (sq.done) continue;
+                  for (std::uint32_t t = begin[other]; t < begin[other + 1]; ++t) {
+                    const double ex = sx[t] - sq.p.x(), ey = sy[t] - sq.p.y(), ez = sz[t] - sq.p.z();
+                    const auto d = static_cast<float>(ex * ex + ey * ey + ez * ez);
+                    if (d < sq.top.worst) sq.top.offer(order[t], d);
+                  }
                 }
               }
             }
           }
-          const double margin = static_cast<double>(r) * grid.h + inner;
-          if (top.count == k && static_cast<double>(top.worst) < margin * margin * (1.0 - 1e-5)) {
-            proven[q] = 1;
-            break;
+          const double margin_base = static_cast<double>(r) * grid.h;
+          for (ShellQuery& sq : queries) {
+            if (sq.done) continue;
+            const double margin = margin_base + sq.inner;
+            if (sq.top.count == k && static_cast<double>(sq.top.worst) < margin * margin * (1.0 - 1e-5)) {
+              proven[sq.q] = 1;
+              sq.done = true;
+              --open;
+            }
           }
         }
-        out->count[q] = static_cast<std::uint32_t>(top.count);
+        for (const ShellQuery& sq : queries) out->count[sq.q] = static_cast<std::uint32_t>(sq.top.count);
       }
     });
     std::erase_if(pending, [&](std::uint32_t q) { return proven[q] != 0; });

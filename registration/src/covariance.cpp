@@ -7,7 +7,9 @@
 
 #include <Eigen/Eigenvalues>
 
+
 #include "cell_knn.hpp"
+#include "offset_sums.hpp"
 #include "rigcal/registration/parallel.hpp"
 
 namespace rigcal::registration {
@@ -57,20 +59,11 @@ bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t
   }
   // One pass of sums relative to the point itself (offsets of a neighbourhood: exact enough in double
   // even far from the origin), then cov = E[d·dᵀ] − E[d]·E[d]ᵀ.
-  const Eigen::Vector3d origin = cloud.points[i].head<3>();
-  double sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
-  for (std::size_t j = 0; j < found; ++j) {
-    const Eigen::Vector3d d = cloud.points[nb[j].index].head<3>() - origin;
-    sx += d.x();
-    sy += d.y();
-    sz += d.z();
-    sxx += d.x() * d.x();
-    sxy += d.x() * d.y();
-    sxz += d.x() * d.z();
-    syy += d.y() * d.y();
-    syz += d.y() * d.z();
-    szz += d.z() * d.z();
-  }
+  static const detail::OffsetSumsKernel offset_sums = detail::fastestOffsetSums();
+  detail::OffsetSums sums;
+  offset_sums(cloud.points.data(), nb, found, cloud.points[i], &sums);
+  const double sx = sums.s[0], sy = sums.s[1], sz = sums.s[2];
+  const double sxx = sums.x[0], sxy = sums.x[1], sxz = sums.x[2], syy = sums.yz[0], syz = sums.yz[1], szz = sums.yz[2];
   const double inv = 1.0 / static_cast<double>(found);
   const double mx = sx * inv, my = sy * inv, mz = sz * inv;
   Eigen::Matrix3d cov;
