@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "top_k.hpp"
+
 namespace rigcal::registration {
 
 namespace {
@@ -215,26 +217,17 @@ namespace {
 // walk will meet again and must not add twice.
 template <bool kSeeded>
 struct KnnSet {
-  Neighbor* out;
-  std::size_t k;
-  std::size_t count;
-  float worst;  // distance a candidate must beat
+  detail::TopK top;
 
-  [[nodiscard]] float bound() const { return worst; }
+  [[nodiscard]] float bound() const { return top.worst; }
   void offer(std::uint32_t i, float d) {
-    if (!(d < worst)) return;
+    if (!(d < top.worst)) return;
     if constexpr (kSeeded) {
-      for (std::size_t c = 0; c < count; ++c) {
-        if (out[c].index == i) return;
+      for (std::size_t c = 0; c < top.count; ++c) {
+        if (top.out[c].index == i) return;
       }
     }
-    std::size_t pos = count < k ? count++ : k - 1;
-    while (pos > 0 && out[pos - 1].sq_distance > d) {
-      out[pos] = out[pos - 1];
-      --pos;
-    }
-    out[pos] = {i, d};
-    if (count == k) worst = out[k - 1].sq_distance;
+    top.offer(i, d);
   }
 };
 }  // namespace
@@ -245,16 +238,16 @@ std::size_t KdTree::knn(const Eigen::Vector4d& q, std::size_t k, Neighbor* out, 
   const Eigen::Vector4f ql = local(q);
   std::size_t count = 0;
   if (hints.empty()) {
-    KnnSet<false> set{out, k, 0, toFloat(max_sq_distance)};
+    KnnSet<false> set{{out, k, 0, toFloat(max_sq_distance)}};
     search(ql, set);
-    count = set.count;
+    count = set.top.count;
   } else {
-    KnnSet<true> set{out, k, 0, toFloat(max_sq_distance)};
+    KnnSet<true> set{{out, k, 0, toFloat(max_sq_distance)}};
     for (const std::uint32_t h : hints) {
       if (h < where_.size()) set.offer(where_[h], (points_[where_[h]] - ql).squaredNorm());
     }
     search(ql, set);
-    count = set.count;
+    count = set.top.count;
   }
   for (std::size_t i = 0; i < count; ++i) out[i].index = index_[out[i].index];
   return count;
