@@ -57,7 +57,16 @@ class CorrespondenceObjective final : public Objective {
   bool graphSearch(const Target& target, std::uint32_t start, const Eigen::Vector4d& q, std::uint32_t* j,
                    float* margin) const;
 
+  /// The target point j for source point g: from held_ when it holds j.
+  [[nodiscard]] Eigen::Vector3d targetPoint(std::size_t g, const PointCloud& tc, std::uint32_t j) const {
+    return held_[g].index == j ? held_[g].point : Eigen::Vector3d(tc.points[j].head<3>());
+  }
+  /// Makes held_[g] hold target point j.
+  void hold(std::size_t g, const Target& target, std::uint32_t j);
+
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+  // A first search (no match yet, the source not yet moved) may answer with a point up to 1.25x as far
+  // as the nearest: it skips cells sooner, and the next pass searches exactly from what it found.
   static constexpr float kFirstSearchError = 0.25F;
   // Cube edge of the sources' spatial order (m): a few source voxels, so a run of queries stays local.
   static constexpr double kOrderCell = 0.5;
@@ -85,12 +94,6 @@ class CorrespondenceObjective final : public Objective {
     std::array<float, 6> covariance{};  // GICP: the target covariance's upper triangle
     std::uint32_t index = kNone;
   };
-  /// The target point j for source point g: from held_ when it holds j.
-  [[nodiscard]] Eigen::Vector3d targetPoint(std::size_t g, const PointCloud& tc, std::uint32_t j) const {
-    return held_[g].index == j ? held_[g].point : Eigen::Vector3d(tc.points[j].head<3>());
-  }
-  /// Makes held_[g] hold target point j.
-  void hold(std::size_t g, const Target& target, std::uint32_t j);
   std::vector<Held> held_;
   std::vector<Sym3> source_cov_;        // GICP: the sources' covariances, compact, concatenated
   std::vector<Eigen::Vector3d> source_axis_;  // GICP: v with C_s = I − v·vᵀ, when every source has that form
