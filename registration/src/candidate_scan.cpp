@@ -4,6 +4,8 @@
 #include <immintrin.h>
 #endif
 
+#include "cpu_features.hpp"
+
 namespace rigcal::registration::detail {
 
 namespace {
@@ -60,13 +62,6 @@ void scanSse2(const CandidateBlock& b, float qx, float qy, float qz, TopK& top) 
   }
 }
 
-bool cpuHasAvx2() {
-  static const bool avx2 = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
-  }();
-  return avx2;
-}
 #endif
 
 }  // namespace

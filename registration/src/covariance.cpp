@@ -7,7 +7,6 @@
 
 #include <Eigen/Eigenvalues>
 
-
 #include "cell_knn.hpp"
 #include "offset_sums.hpp"
 #include "rigcal/registration/parallel.hpp"

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <iterator>
 
+#include "cpu_features.hpp"
+
 namespace rigcal::registration::detail {
 
 namespace {
@@ -90,14 +92,6 @@ struct Columns {
 
 void accumulateBaseline(const Columns& c, double (*sums)[kLanes]) { accumulateLanes(c, sums); }
 [[gnu::target("avx2")]] void accumulateAvx2(const Columns& c, double (*sums)[kLanes]) { accumulateLanes(c, sums); }
-
-bool cpuHasAvx2() {
-  static const bool avx2 = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
-  }();
-  return avx2;
-}
 
 }  // namespace
 

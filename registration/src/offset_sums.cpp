@@ -4,6 +4,8 @@
 #include <immintrin.h>
 #endif
 
+#include "cpu_features.hpp"
+
 namespace rigcal::registration::detail {
 
 void offsetSumsScalar(const Eigen::Vector4d* points, const Neighbor* nb, std::size_t found,
@@ -50,8 +52,7 @@ namespace {
 
 OffsetSumsKernel fastestOffsetSums() {
 #if defined(__x86_64__)
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2") != 0) return offsetSumsAvx2;
+  if (cpuHasAvx2()) return offsetSumsAvx2;
 #endif
   return offsetSumsScalar;
 }
