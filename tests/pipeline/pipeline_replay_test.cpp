@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <map>
-#include <mutex>
 #include <thread>
 
 #include <unistd.h>
@@ -32,21 +31,11 @@ struct Recorded : sim::SimulationSink {
 
 test::RunResult replay(const config::RigConfig& rig, const std::vector<Scan>& scans, PipelineOptions o,
                        double* push_seconds = nullptr) {
-  test::RunResult r;
-  std::mutex m;
-  Pipeline pipeline(rig, o, [&](std::shared_ptr<const CalibrationDataset> d) {
-    std::lock_guard lock(m);
-    r.datasets.push_back(std::move(d));
+  return test::runPipeline(rig, o, [&](Pipeline& pipeline) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const Scan& s : scans) pipeline.push(s);
+    if (push_seconds) *push_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   });
-  const auto t0 = std::chrono::steady_clock::now();
-  for (const Scan& s : scans) pipeline.push(s);
-  if (push_seconds) *push_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  pipeline.finish();
-  r.mapping = pipeline.mapping(/*with_dense_cloud=*/true);
-  r.progress = pipeline.progress();
-  r.stats = pipeline.stats();
-  r.shortfalls = pipeline.shortfalls();
-  return r;
 }
 
 class Replayed : public ::testing::Test {

@@ -39,25 +39,33 @@ class Feeder : public sim::SimulationSink {
   Pipeline& pipeline_;
 };
 
-/// Simulates `duration_s` of the scenario straight into an offline pipeline.
-inline RunResult runInProcess(const sim::Simulation& sim, const config::RigConfig& rig, double duration_s,
-                              PipelineOptions options = {}) {
+/// Runs a pipeline over what `feed(pipeline)` pushes, finishes it and collects everything it produced.
+template <class Feed>
+RunResult runPipeline(const config::RigConfig& rig, const PipelineOptions& options, Feed&& feed) {
   RunResult r;
   std::mutex m;
   Pipeline pipeline(rig, options, [&](std::shared_ptr<const CalibrationDataset> d) {
     std::lock_guard lock(m);
     r.datasets.push_back(std::move(d));
   });
-  Feeder feeder(pipeline);
-  sim::SimulationOptions so;
-  so.max_duration_ns = fromSeconds(duration_s);
-  sim.run(feeder, so);
+  feed(pipeline);
   pipeline.finish();
   r.mapping = pipeline.mapping(/*with_dense_cloud=*/true);
   r.progress = pipeline.progress();
   r.stats = pipeline.stats();
   r.shortfalls = pipeline.shortfalls();
   return r;
+}
+
+/// Simulates `duration_s` of the scenario straight into an offline pipeline.
+inline RunResult runInProcess(const sim::Simulation& sim, const config::RigConfig& rig, double duration_s,
+                              PipelineOptions options = {}) {
+  return runPipeline(rig, options, [&](Pipeline& pipeline) {
+    Feeder feeder(pipeline);
+    sim::SimulationOptions so;
+    so.max_duration_ns = fromSeconds(duration_s);
+    sim.run(feeder, so);
+  });
 }
 
 /// The true pose of sensor `index` at its own clock's `stamp`.
