@@ -18,7 +18,7 @@ namespace rigcal::registration::detail {
 CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> pairs, Residual kind,
                                                  double max_distance, int num_threads)
     : pairs_(pairs), kind_(kind), max_sq_(max_distance * max_distance), num_threads_(num_threads) {
-  chunks_ = makeChunks(pairs);
+  chunks_ = makeChunks(pairs, kChunkSize);
   std::size_t total = 0;
   for (const auto& p : pairs) total += p.source->size();
   // Every per-point array below is in each source's spatial order, and so are the chunks: a chunk's
@@ -56,6 +56,13 @@ CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> p
       }
     }
   }
+}
+
+bool CorrespondenceObjective::useEvery(std::size_t stride) {
+  if (stride == 0 || (stride & (stride - 1)) != 0 || kChunkSize % stride != 0) return false;
+  stride_ = stride;
+  cached_.reset();  // a linearisation over the other subset
+  return true;
 }
 
 // Every target point outside {c} ∪ N(c) is at least R_c from c, hence at least R_c − |q − c| from q. So
@@ -200,7 +207,7 @@ CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const Pair
   LinearSystem& sys = out.sys;
   PointToPointSums p2p;
   GicpBatch gicp;
-  for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+  for (std::size_t i = chunk.begin; i < chunk.end; i += stride_) {
     const std::size_t g = chunk.offset + (i - chunk.begin);
     const Eigen::Vector4d q4 = M * source_points_[g];
     if constexpr (kPrevious) {  // exactly costChunk's term: the acceptance test sees the same number
@@ -253,7 +260,7 @@ template <Residual K>
 double CorrespondenceObjective::costChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) const {
   const PointCloud& tc = pairs_[chunk.pair].target->cloud();
   double cost = 0.0;
-  for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+  for (std::size_t i = chunk.begin; i < chunk.end; i += stride_) {
     const std::size_t g = chunk.offset + (i - chunk.begin);
     const std::uint32_t j = used_[g];  // the same matches as the linearisation: the cost is comparable
     if (j == kNone) continue;
@@ -313,7 +320,8 @@ std::optional<LinearSystem> CorrespondenceObjective::measure(const Pose& T, cons
     }
     const PairChunk& chunk = chunks_[t];
     const Target& target = *pairs_[chunk.pair].target;
-    for (std::size_t g = chunk.offset; g < chunk.offset + (chunk.end - chunk.begin); ++g) {
+    for (std::size_t i = chunk.begin; i < chunk.end; i += stride_) {
+      const std::size_t g = chunk.offset + (i - chunk.begin);
       const Eigen::Vector4d q = M * source_points_[g];
       std::uint32_t j = kNone;
       if (!match(target, g, q, &j)) continue;

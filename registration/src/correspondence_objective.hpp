@@ -24,6 +24,9 @@ class CorrespondenceObjective final : public Objective {
   std::optional<double> cost(const Pose& T, const Deadline& deadline, bool then_linearize) override;
   /// Matches only, through the same cache: after convergence almost no point needs the tree.
   std::optional<LinearSystem> measure(const Pose& T, const Deadline& deadline) override;
+  /// Every stride-th point of each source's spatial order: a uniform subsample. A power of two up to
+  /// the chunk size, so that chunks stay aligned to it.
+  bool useEvery(std::size_t stride) override;
 
  private:
   /// A linearisation's sums, and with kPrevious also the cost at the same pose with the previous
@@ -70,10 +73,12 @@ class CorrespondenceObjective final : public Objective {
   static constexpr float kFirstSearchError = 0.25F;
   // Cube edge of the sources' spatial order (m): a few source voxels, so a run of queries stays local.
   static constexpr double kOrderCell = 0.5;
+  static constexpr std::size_t kChunkSize = 512;  // source points per parallel task
   std::span<const SourceTarget> pairs_;
   Residual kind_;
   double max_sq_;
   int num_threads_;
+  std::size_t stride_ = 1;  // see useEvery()
   std::vector<PairChunk> chunks_;           // over positions in the spatial order (not source indices)
   std::vector<Eigen::Vector4d> source_points_;  // every source's points in spatial order, concatenated
   std::vector<std::uint32_t> match_;    // per source point (concatenated): target index or kNone

@@ -34,7 +34,8 @@ RegistrationResult alignGicp(const Target& target, const PointCloud& source, con
   const std::span<const SourceTarget> pairs(&pair, 1);
   detail::CorrespondenceObjective objective(pairs, detail::Residual::kGicp, params.max_correspondence_distance,
                                             params.num_threads);
-  const detail::SolveOutcome outcome = detail::solve(objective, guess, params, deadline);
+  const detail::SolveOutcome outcome =
+      detail::solveCoarseToFine(objective, pair.source->size(), guess, params, deadline);
   return detail::finish(outcome, objective, pairs, params.max_correspondence_distance, params, deadline, kName);
 }
 

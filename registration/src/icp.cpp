@@ -18,7 +18,9 @@ RegistrationResult alignBatchedIcp(std::span<const SourceTarget> pairs, const Po
   detail::CorrespondenceObjective objective(
       pairs, params.method == IcpMethod::kPointToPlane ? detail::Residual::kPointToPlane : detail::Residual::kPointToPoint,
       params.max_correspondence_distance, params.num_threads);
-  const detail::SolveOutcome outcome = detail::solve(objective, guess, params, deadline);
+  std::size_t source_points = 0;
+  for (const auto& p : pairs) source_points += p.source->size();
+  const detail::SolveOutcome outcome = detail::solveCoarseToFine(objective, source_points, guess, params, deadline);
   return detail::finish(outcome, objective, pairs, params.max_correspondence_distance, params, deadline, name);
 }
 

@@ -103,6 +103,39 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
   return out;
 }
 
+// The first iterations move the source furthest, so each pays a fresh nearest-neighbour search for every
+// point, while a uniform subsample of a few thousand points already finds the same basin: it takes those
+// steps for a fraction of the searches, and all points then start next to their optimum (searches short
+// or skipped). Bench scan-to-map GICP, 18.7k points: 45 → 25 ms. The two stages may settle in different
+// local minima of the piecewise matching cost, within the convergence tolerance of each other.
+constexpr std::size_t kCoarseMinPoints = 4096;  // what the subsample keeps at least
+constexpr std::size_t kMaxCoarseStride = 4;
+
+SolveOutcome solveCoarseToFine(Objective& objective, std::size_t source_points, const Pose& guess,
+                               const SolverParams& params, const Deadline& deadline) {
+  std::size_t stride = 1;
+  while (2 * stride <= kMaxCoarseStride && source_points / (2 * stride) >= kCoarseMinPoints) stride *= 2;
+  SolverParams coarse_params = params;
+  coarse_params.max_iterations = params.max_iterations / 2;  // the fine stage always gets the rest
+  if (!params.coarse_to_fine || stride == 1 || coarse_params.max_iterations == 0 || !objective.useEvery(stride)) {
+    return solve(objective, guess, params, deadline);
+  }
+  const SolveOutcome coarse = solve(objective, guess, coarse_params, deadline);
+  objective.useEvery(1);
+  if (coarse.status == Status::kTimeout || coarse.status == Status::kCancelled) {
+    SolveOutcome out = coarse;
+    out.linearized = false;  // its metrics cover the subsample only: report its pose, unevaluated
+    return out;
+  }
+  // Too few matches or a bad system in the subsample: all points decide from the guess, as without it.
+  const bool moved = coarse.status == Status::kConverged || coarse.status == Status::kMaxIterations;
+  SolverParams fine_params = params;
+  fine_params.max_iterations = params.max_iterations - (moved ? coarse.iterations : 0);
+  SolveOutcome fine = solve(objective, moved ? coarse.T : guess, fine_params, deadline);
+  if (moved) fine.iterations += coarse.iterations;
+  return fine;
+}
+
 std::string validateInputs(std::span<const SourceTarget> pairs, const Pose& guess, const SolverParams& params,
                            double max_distance) {
   if (pairs.empty()) return "no source/target pair given";

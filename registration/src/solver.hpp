@@ -56,6 +56,9 @@ class Objective {
   /// cheaper than a fresh evaluation; nullopt means "use evaluatePairs" (or the deadline passed).
   virtual std::optional<LinearSystem> measure(const Pose& /*T*/, const Deadline& /*deadline*/) { return std::nullopt; }
   /// Largest update norm allowed per iteration (NDT's step_size); unlimited by default.
+  /// Matches and sums only every stride-th source point from now on (1: all of them); false when the
+  /// objective cannot subsample (then it keeps using all).
+  virtual bool useEvery(std::size_t /*stride*/) { return false; }
   [[nodiscard]] virtual double maxStep() const { return std::numeric_limits<double>::infinity(); }
 };
 
@@ -71,6 +74,11 @@ struct SolveOutcome {
 };
 
 SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& params, const Deadline& deadline);
+
+/// solve(), first on a uniform subsample of the `source_points` when there are enough of them, then on
+/// all of them from where the subsample converged. Iterations count both stages.
+SolveOutcome solveCoarseToFine(Objective& objective, std::size_t source_points, const Pose& guess,
+                               const SolverParams& params, const Deadline& deadline);
 
 /// Checks what every method needs; returns an empty string when fine, else the reason.
 std::string validateInputs(std::span<const SourceTarget> pairs, const Pose& guess, const SolverParams& params,

@@ -37,6 +37,7 @@ struct RunOptions {
   double ndt_resolution = 1.0;
   int max_iterations = 64;
   std::size_t min_correspondences = 10;
+  bool coarse_to_fine = true;
 };
 
 /// The source must carry covariances for GICP; the target everything the method needs.
@@ -46,6 +47,7 @@ inline RegistrationResult run(Method m, const Target& target, const PointCloud& 
     p.num_threads = o.threads;
     p.max_iterations = o.max_iterations;
     p.min_correspondences = o.min_correspondences;
+    p.coarse_to_fine = o.coarse_to_fine;
   };
   switch (m) {
     case Method::kPointToPoint:

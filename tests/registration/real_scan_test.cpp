@@ -130,6 +130,56 @@ TEST(RealScan, BatchedIcpOverThreeSensors) {
   }
 }
 
+// Sources of 8k+ points iterate on a subsample first (SolverParams::coarse_to_fine).
+TEST(RealScan, CoarseToFineLandsWhereAllPointsDo) {
+  RIGCAL_REQUIRE_DATA(path, "velodyne/vlp32c_fov270to90.reference.pcd");
+  const PointCloud raw = test::loadScan(path);
+  const Target target(voxelDownsample(raw, 0.05), test::fullTarget());
+  PointCloud source = test::movedCopy(raw, test::knownTransform(), kSigma, 2, 1);
+  ASSERT_GE(source.size(), 8192U);  // large enough for a coarse stage
+  estimateCovariances(source);
+  for (const Method m : {Method::kGicp, Method::kPointToPlane, Method::kPointToPoint}) {
+    test::RunOptions all_only;
+    all_only.coarse_to_fine = false;
+    const RegistrationResult a = test::run(m, target, source, Pose::Identity());
+    const RegistrationResult b = test::run(m, target, source, Pose::Identity(), all_only);
+    SCOPED_TRACE(test::name(m) + ": " + a.reason + " / " + b.reason);
+    EXPECT_EQ(a.status, Status::kConverged);
+    EXPECT_EQ(b.status, Status::kConverged);
+    EXPECT_LT(test::translationError(a.T_target_source, b.T_target_source), 1e-3);
+    EXPECT_LT(test::rotationErrorDeg(a.T_target_source, b.T_target_source), 0.01);
+    // The metrics count every point, not the subsample's.
+    EXPECT_NEAR(static_cast<double>(a.inliers), static_cast<double>(b.inliers), 0.01 * static_cast<double>(b.inliers));
+    EXPECT_GT(a.inlier_ratio, 0.9);
+  }
+}
+
+TEST(RealScan, CoarseToFineKeepsTheIterationBudgetAndTheDeadline) {
+  RIGCAL_REQUIRE_DATA(path, "velodyne/vlp32c_fov270to90.reference.pcd");
+  const PointCloud raw = test::loadScan(path);
+  const Target target(voxelDownsample(raw, 0.05), test::fullTarget());
+  PointCloud source = test::movedCopy(raw, test::knownTransform(), kSigma, 2, 1);
+  estimateCovariances(source);
+  const double initial_error = test::translationError(Pose::Identity(), test::knownTransform());
+  for (const int budget : {1, 2, 3, 5}) {
+    test::RunOptions o;
+    o.max_iterations = budget;
+    const RegistrationResult r = test::run(Method::kGicp, target, source, Pose::Identity(), o);
+    SCOPED_TRACE(r.reason);
+    EXPECT_GE(r.iterations, 1);
+    EXPECT_LE(r.iterations, budget);
+    EXPECT_LT(test::translationError(r.T_target_source, test::knownTransform()), initial_error);
+  }
+  // Out of time in the coarse stage (the first pass alone takes longer than this).
+  const auto budget = std::chrono::microseconds(300);
+  const auto start = std::chrono::steady_clock::now();
+  const RegistrationResult r =
+      test::run(Method::kGicp, target, source, Pose::Identity(), {}, Deadline::after(budget));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, budget + std::chrono::milliseconds(400));
+  EXPECT_EQ(r.status, Status::kTimeout) << r.reason;
+  EXPECT_TRUE(r.T_target_source.matrix().allFinite());
+}
+
 TEST(RealScan, FullScanUnderADeadline) {
   // The whole 208k-point scan as source against its NDT map: far more than the 50 ms budget allows.
   RIGCAL_REQUIRE_DATA(path, "velodyne/vls128_strongest.reference.pcd");
