@@ -4,7 +4,8 @@
 // The SIMD paths compute 4 (SSE2) or 8 (AVX2) distances and one comparison mask at a time instead of a
 // distance array then a scalar filter. Every path does the same float operations in the same order
 // ((dx² + dy²) + dz², never a fused multiply-add) and offers in the same order, so all give the scalar
-// loop's answer bit for bit.
+// loop's answer bit for bit. The AVX2 path also keeps up to 16 best in registers instead of TopK's
+// array, inserting without a branch (same ranks and ties).
 #include <cstddef>
 #include <cstdint>
 
