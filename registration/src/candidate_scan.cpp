@@ -48,15 +48,19 @@ void scanSse2(const CandidateBlock& b, float qx, float qy, float qz, TopK& top) 
 }
 
 // target("avx2") only, not "fma": the compiler must not contract the products and sums.
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256 squaredDistancesAvx2(const CandidateBlock& b, std::size_t j,
+                                                                              __m256 px, __m256 py, __m256 pz) {
+  const __m256 ex = _mm256_sub_ps(_mm256_loadu_ps(b.x + j), px);
+  const __m256 ey = _mm256_sub_ps(_mm256_loadu_ps(b.y + j), py);
+  const __m256 ez = _mm256_sub_ps(_mm256_loadu_ps(b.z + j), pz);
+  return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey)), _mm256_mul_ps(ez, ez));
+}
+
 [[gnu::target("avx2")]] void scanAvx2(const CandidateBlock& b, float qx, float qy, float qz, TopK& top) {
   const __m256 px = _mm256_set1_ps(qx), py = _mm256_set1_ps(qy), pz = _mm256_set1_ps(qz);
   alignas(32) float d[8];
   for (std::size_t j = 0; j < b.size; j += 8) {
-    const __m256 ex = _mm256_sub_ps(_mm256_loadu_ps(b.x + j), px);
-    const __m256 ey = _mm256_sub_ps(_mm256_loadu_ps(b.y + j), py);
-    const __m256 ez = _mm256_sub_ps(_mm256_loadu_ps(b.z + j), pz);
-    const __m256 d2 =
-        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey)), _mm256_mul_ps(ez, ez));
+    const __m256 d2 = squaredDistancesAvx2(b, j, px, py, pz);
     const auto mask =
         static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(d2, _mm256_set1_ps(top.worst), _CMP_LT_OQ)));
     if (mask == 0) continue;
@@ -92,11 +96,7 @@ void scanSse2(const CandidateBlock& b, float qx, float qy, float qz, TopK& top) 
   std::size_t count = top.count;
   alignas(32) float d[8];
   for (std::size_t j = 0; j < b.size; j += 8) {
-    const __m256 ex = _mm256_sub_ps(_mm256_loadu_ps(b.x + j), px);
-    const __m256 ey = _mm256_sub_ps(_mm256_loadu_ps(b.y + j), py);
-    const __m256 ez = _mm256_sub_ps(_mm256_loadu_ps(b.z + j), pz);
-    const __m256 d2 =
-        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey)), _mm256_mul_ps(ez, ez));
+    const __m256 d2 = squaredDistancesAvx2(b, j, px, py, pz);
     auto mask = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(d2, _mm256_set1_ps(bound), _CMP_LT_OQ)));
     if (mask == 0) continue;
     _mm256_store_ps(d, d2);

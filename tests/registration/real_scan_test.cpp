@@ -24,10 +24,16 @@ struct Case {
   double ndt_resolution = 1.0;
 };
 
-// Source: every `stride`-th raw point (offset by one, so not the target's samples), moved and noisy.
-void expectRecovered(const Target& target, const PointCloud& raw, std::size_t stride, const std::vector<Case>& cases) {
+// Every `stride`-th raw point (offset by one, so not the target's samples), moved and noisy, with
+// covariances.
+PointCloud movedSource(const PointCloud& raw, std::size_t stride) {
   PointCloud source = test::movedCopy(raw, test::knownTransform(), kSigma, stride, 1);
   estimateCovariances(source);
+  return source;
+}
+
+void expectRecovered(const Target& target, const PointCloud& raw, std::size_t stride, const std::vector<Case>& cases) {
+  const PointCloud source = movedSource(raw, stride);
   for (const Case& c : cases) {
     test::RunOptions o;
     o.ndt_resolution = c.ndt_resolution;
@@ -87,8 +93,7 @@ TEST(RealScan, OneAndTwoThreadsGiveIdenticalResults) {
   RIGCAL_REQUIRE_DATA(path, "velodyne/vlp32c_fov270to90.reference.pcd");
   const PointCloud raw = test::loadScan(path);
   const Target target(voxelDownsample(raw, 0.05), test::fullTarget(0.5, 2));
-  PointCloud source = test::movedCopy(raw, test::knownTransform(), kSigma, 2, 1);
-  estimateCovariances(source);
+  const PointCloud source = movedSource(raw, 2);
   for (const Method m : test::allMethods()) {
     test::RunOptions one, two;
     one.ndt_resolution = two.ndt_resolution = 0.5;
@@ -135,9 +140,8 @@ TEST(RealScan, CoarseToFineLandsWhereAllPointsDo) {
   RIGCAL_REQUIRE_DATA(path, "velodyne/vlp32c_fov270to90.reference.pcd");
   const PointCloud raw = test::loadScan(path);
   const Target target(voxelDownsample(raw, 0.05), test::fullTarget());
-  PointCloud source = test::movedCopy(raw, test::knownTransform(), kSigma, 2, 1);
+  const PointCloud source = movedSource(raw, 2);
   ASSERT_GE(source.size(), 8192U);  // large enough for a coarse stage
-  estimateCovariances(source);
   for (const Method m : {Method::kGicp, Method::kPointToPlane, Method::kPointToPoint}) {
     test::RunOptions all_only;
     all_only.coarse_to_fine = false;
@@ -158,8 +162,7 @@ TEST(RealScan, CoarseToFineKeepsTheIterationBudgetAndTheDeadline) {
   RIGCAL_REQUIRE_DATA(path, "velodyne/vlp32c_fov270to90.reference.pcd");
   const PointCloud raw = test::loadScan(path);
   const Target target(voxelDownsample(raw, 0.05), test::fullTarget());
-  PointCloud source = test::movedCopy(raw, test::knownTransform(), kSigma, 2, 1);
-  estimateCovariances(source);
+  const PointCloud source = movedSource(raw, 2);
   const double initial_error = test::translationError(Pose::Identity(), test::knownTransform());
   for (const int budget : {1, 2, 3, 5}) {
     test::RunOptions o;
