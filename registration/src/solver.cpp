@@ -106,10 +106,12 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
 // The first iterations move the source furthest, so each pays a fresh nearest-neighbour search for every
 // point, while a uniform subsample of a few thousand points already finds the same basin: it takes those
 // steps for a fraction of the searches, and all points then start next to their optimum (searches short
-// or skipped). Bench scan-to-map GICP, 18.7k points: 45 → 25 ms. The two stages may settle in different
-// local minima of the piecewise matching cost, within the convergence tolerance of each other.
+// or skipped). Bench scan-to-map GICP, 18.7k points (stride 4): 45 → 25 ms; a 105k-point VLS-128 scan
+// against its 141k-point map (stride 16): 3x faster for GICP and ICP alike, from 0.3–1 m and 3–15° off,
+// and every start that converged with all points alone still converged. The two stages may settle in
+// different local minima of the piecewise matching cost, within the convergence tolerance of each other.
 constexpr std::size_t kCoarseMinPoints = 4096;  // what the subsample keeps at least
-constexpr std::size_t kMaxCoarseStride = 4;
+constexpr std::size_t kMaxCoarseStride = 256;
 
 SolveOutcome solveCoarseToFine(Objective& objective, std::size_t source_points, const Pose& guess,
                                const SolverParams& params, const Deadline& deadline) {

@@ -142,12 +142,18 @@ TEST(RealScan, CoarseToFineLandsWhereAllPointsDo) {
   const Target target(voxelDownsample(raw, 0.05), test::fullTarget());
   const PointCloud source = movedSource(raw, 2);
   ASSERT_GE(source.size(), 8192U);  // large enough for a coarse stage
-  for (const Method m : {Method::kGicp, Method::kPointToPlane, Method::kPointToPoint}) {
+  // From the identity (0.36 m and 3.2° off), and from about 0.9 m and 14° off in another direction.
+  const Pose far_off = fromXyzRpy({-0.2, 0.5, -0.1, deg2rad(-4.0), deg2rad(3.0), deg2rad(-10.0)});
+  for (const auto& [m, guess] : {std::pair{Method::kGicp, Pose::Identity()}, std::pair{Method::kPointToPlane, Pose::Identity()},
+                                 std::pair{Method::kPointToPoint, Pose::Identity()}, std::pair{Method::kGicp, far_off},
+                                 std::pair{Method::kPointToPlane, far_off}}) {
     test::RunOptions all_only;
     all_only.coarse_to_fine = false;
-    const RegistrationResult a = test::run(m, target, source, Pose::Identity());
-    const RegistrationResult b = test::run(m, target, source, Pose::Identity(), all_only);
+    const RegistrationResult a = test::run(m, target, source, guess);
+    const RegistrationResult b = test::run(m, target, source, guess, all_only);
     SCOPED_TRACE(test::name(m) + ": " + a.reason + " / " + b.reason);
+    EXPECT_LT(test::translationError(a.T_target_source, test::knownTransform()), 1e-3);
+    EXPECT_LT(test::rotationErrorDeg(a.T_target_source, test::knownTransform()), 0.01);
     EXPECT_EQ(a.status, Status::kConverged);
     EXPECT_EQ(b.status, Status::kConverged);
     EXPECT_LT(test::translationError(a.T_target_source, b.T_target_source), 1e-3);
