@@ -112,6 +112,8 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
 // different local minima of the piecewise matching cost, within the convergence tolerance of each other.
 constexpr std::size_t kCoarseMinPoints = 4096;  // what the subsample keeps at least
 constexpr std::size_t kMaxCoarseStride = 256;
+constexpr double kCoarseTranslationEpsilon = 1e-3;  // m
+constexpr double kCoarseRotationEpsilon = 1e-3;     // rad
 
 SolveOutcome solveCoarseToFine(Objective& objective, std::size_t source_points, const Pose& guess,
                                const SolverParams& params, const Deadline& deadline) {
@@ -119,6 +121,10 @@ SolveOutcome solveCoarseToFine(Objective& objective, std::size_t source_points, 
   while (2 * stride <= kMaxCoarseStride && source_points / (2 * stride) >= kCoarseMinPoints) stride *= 2;
   SolverParams coarse_params = params;
   coarse_params.max_iterations = params.max_iterations / 2;  // the fine stage always gets the rest
+  // Close enough for the fine stage: tighter tolerances only make the subsample grind on matches it
+  // cannot resolve (the ensemble's ultra-fine ICP, 1e-5 m / 1e-6 rad: 100 coarse iterations, not converged).
+  coarse_params.transformation_epsilon = std::max(params.transformation_epsilon, kCoarseTranslationEpsilon);
+  coarse_params.rotation_epsilon = std::max(params.rotation_epsilon, kCoarseRotationEpsilon);
   if (!params.coarse_to_fine || stride == 1 || coarse_params.max_iterations == 0 || !objective.useEvery(stride)) {
     return solve(objective, guess, params, deadline);
   }

@@ -10,7 +10,10 @@
 
 #include "lidar_lidar_sim_dataset.hpp"
 #include "rigcal/calib/base_lidar_calibration.hpp"
+#include "rigcal/calib/augmented_target.hpp"
 #include "rigcal/calib/calibration_deskew.hpp"
+#include "rigcal/calib/calibration_source.hpp"
+#include "rigcal/calib/ensemble_plan.hpp"
 #include "rigcal/calib/calibration_scheduler.hpp"
 #include "rigcal/calib/calibration_score.hpp"
 #include "rigcal/calib/calibration_yaml_writer.hpp"
@@ -67,6 +70,28 @@ TEST_F(LidarLidarSim, EachCalibrationLidarWithinOneCentimetreAndFiveHundredthsOf
     } else {  // two frames only
       EXPECT_LT(dt, 0.03) << d.calibration_sensor;
       EXPECT_LT(dr, 0.15) << d.calibration_sensor;
+    }
+  }
+}
+
+TEST_F(LidarLidarSim, EveryRegistratorConvergesFromTheGuessWithinItsIterations) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
+  // The ensemble's tolerances are tight (1e-5 m / 1e-6 rad, 200 iterations): a registrator that runs out
+  // of iterations instead of converging wastes the budget (the coarse-to-fine subsample once did).
+  SourceOptions so;
+  so.num_threads = 2;
+  AugmentedTargetOptions to;
+  to.num_threads = 2;
+  for (const auto& d : data().datasets) {
+    for (std::size_t f = 0; f < d.frames.size(); ++f) {
+      const registration::PointCloud source = buildSource(*d.frames[f].deskewed, data().params, so);
+      const auto target = buildAugmentedTarget(d, f, source, data().params, to).target;
+      for (const Registrator r : perFrameRegistrators()) {
+        const auto res = runRegistrator(r, *target, source, d.T_mapping_calib_guess, data().params, 2,
+                                        registration::Deadline::never());
+        EXPECT_EQ(res.status, registration::Status::kConverged)
+            << d.calibration_sensor << " frame " << f << ", " << toString(r) << ": " << res.reason;
+      }
     }
   }
 }
