@@ -128,7 +128,7 @@ float KdTree::initialBound(const Eigen::Vector4f& q, float* off) const {
 // Depth-first, nearest child first, without recursion. Each pending far child carries the squared
 // distance from q to its cell along every axis (off) and their sum (rd): a lower bound on the distance
 // to any point below it (incremental distance, Arya & Mount), so it is skipped once the bound is beaten.
-// `Set` keeps the candidates: bound() is the distance a point must beat, offer(i, d) proposes one.
+// `Set` keeps the candidates: bound() is the distance a point must beat, scanLeaf() offers a leaf's points.
 template <class Set>
 void KdTree::search(const Eigen::Vector4f& q, Set& set) const {
   struct Pending {
@@ -150,7 +150,7 @@ void KdTree::search(const Eigen::Vector4f& q, Set& set) const {
     for (;;) {
       const Node& node = nodes_[id];
       if (node.axis == kLeaf) {
-        for (std::uint32_t i = node.begin; i < node.end; ++i) set.offer(i, (points_[i] - q).squaredNorm());
+        set.scanLeaf(points_.data(), node.begin, node.end, q);
         break;
       }
       const std::uint32_t a = node.axis;
@@ -185,11 +185,19 @@ struct NearestSet {
   float d;
   float prune;  // 1, or 1 / (1 + ε)² for a (1 + ε)-approximate answer: cells must be that much closer
   [[nodiscard]] float bound() const { return d * prune; }
-  void offer(std::uint32_t i, float dist) {
-    if (dist < d) {
-      d = dist;
-      index = i;
+  // Selects, not a branch per point: whether a leaf's point beats the best so far is a coin flip for the
+  // branch predictor (callgrind: a sixth fewer mispredicted branches in a scan-to-map GICP alignment).
+  void scanLeaf(const Eigen::Vector4f* points, std::uint32_t begin, std::uint32_t end, const Eigen::Vector4f& q) {
+    float best = d;
+    std::uint32_t at = index;
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const float dist = (points[i] - q).squaredNorm();
+      const bool closer = dist < best;
+      best = closer ? dist : best;
+      at = closer ? i : at;
     }
+    d = best;
+    index = at;
   }
 };
 }  // namespace
@@ -220,6 +228,9 @@ struct KnnSet {
   detail::TopK top;
 
   [[nodiscard]] float bound() const { return top.worst; }
+  void scanLeaf(const Eigen::Vector4f* points, std::uint32_t begin, std::uint32_t end, const Eigen::Vector4f& q) {
+    for (std::uint32_t i = begin; i < end; ++i) offer(i, (points[i] - q).squaredNorm());
+  }
   void offer(std::uint32_t i, float d) {
     if (!(d < top.worst)) return;
     if constexpr (kSeeded) {
