@@ -56,7 +56,9 @@ void calibratePreset(const std::string& label, const std::string& scenario_arg, 
   // One deadline for every calibration lidar together, whenever their datasets came (a step that does
   // not fit is not started: the overshoot is a fraction of a step).
   const double deadline = report["deadline_s"].get<double>();
-  EXPECT_LT(report["stage_seconds"]["lidar_lidar"].get<double>(), 1.05 * deadline + 1.0) << report["stage_seconds"];
+  if (rigcal::test::kWallClockAsserted) {
+    EXPECT_LT(report["stage_seconds"]["lidar_lidar"].get<double>(), 1.05 * deadline + 1.0) << report["stage_seconds"];
+  }
 }
 
 TEST(CalibratePresetsLong, ParkingLot) {

@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "sanitizers.hpp"
 #include "rigcal/drivers/pcap_replayer.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
 #include "rigcal/drivers/udp_source.hpp"
@@ -161,7 +162,7 @@ TEST(LiveReplay, MaxRateIgnoresTheRecordedTiming) {
   const auto expected = readCapture(file, 2368);
   const TimeNs span = expected.back().time - expected.front().time;
   const LiveRun run = replayInProcess(file, 2368, 0.0);
-  EXPECT_LT(run.replay.duration_ns, span / 4);
+  if (rigcal::test::kWallClockAsserted) { EXPECT_LT(run.replay.duration_ns, span / 4); }
   EXPECT_EQ(run.replay.late_packets, 0u);
   // Without pacing the receiver may fall behind; what arrived is still in order and counted.
   EXPECT_EQ(run.received.size() + run.source_stats.kernel_drops, expected.size());
@@ -250,7 +251,8 @@ TEST(ReplayCommand, RateOneTakesAboutTheCaptureDuration) {
   EXPECT_NE(out.find("replayed " + std::to_string(expected.size()) + " packets"), std::string::npos) << out;
   std::cout << out << "wall " << wall << " s for a capture span of " << toSeconds(span) << " s\n";
   EXPECT_GE(wall, toSeconds(span));
-  EXPECT_LT(wall, toSeconds(span) + 0.75);  // process start-up and file opening included
+  // Process start-up and file opening included.
+  if (rigcal::test::kWallClockAsserted) { EXPECT_LT(wall, toSeconds(span) + 0.75); }
 
   expectSameDatagramsInOrder(received, expected);
   expectIncreasingTimes(received);

@@ -101,7 +101,7 @@ TEST_F(Replayed, RealtimeNeverBlocksTheInputAndCountsDrops) {
   std::cout << r.stats.table();
   // Pushing every scan at once cannot wait for the mapper: the oldest work is dropped and counted.
   EXPECT_GT(dropped, 0u);
-  EXPECT_LT(push_seconds, 0.5 * double(recorded_.scans.size()) / 20.0);
+  if (rigcal::test::kWallClockAsserted) { EXPECT_LT(push_seconds, 0.5 * double(recorded_.scans.size()) / 20.0); }
   EXPECT_LT(r.progress.registered, r.progress.mapping_scans);
   EXPECT_GT(r.progress.registered, 0u);
 }

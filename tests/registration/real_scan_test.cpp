@@ -4,6 +4,7 @@
 
 #include <chrono>
 
+#include "sanitizers.hpp"
 #include "methods.hpp"
 #include "rigcal/registration/covariance.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
@@ -184,7 +185,9 @@ TEST(RealScan, CoarseToFineKeepsTheIterationBudgetAndTheDeadline) {
   const auto start = std::chrono::steady_clock::now();
   const RegistrationResult r =
       test::run(Method::kGicp, target, source, Pose::Identity(), {}, Deadline::after(budget));
-  EXPECT_LT(std::chrono::steady_clock::now() - start, budget + std::chrono::milliseconds(400));
+  if (rigcal::test::kWallClockAsserted) {
+    EXPECT_LT(std::chrono::steady_clock::now() - start, budget + std::chrono::milliseconds(400));
+  }
   EXPECT_EQ(r.status, Status::kTimeout) << r.reason;
   EXPECT_TRUE(r.T_target_source.matrix().allFinite());
 }
@@ -202,7 +205,9 @@ TEST(RealScan, FullScanUnderADeadline) {
   const RegistrationResult r = test::run(Method::kNdt, target, source, Pose::Identity(), {}, Deadline::after(budget));
   const auto elapsed = std::chrono::steady_clock::now() - start;
   EXPECT_EQ(r.status, Status::kTimeout) << r.reason;
-  EXPECT_LT(elapsed, budget + std::chrono::milliseconds(400));  // slack: see the synthetic deadline test
+  if (rigcal::test::kWallClockAsserted) {
+    EXPECT_LT(elapsed, budget + std::chrono::milliseconds(400));  // slack: see the synthetic deadline test
+  }
   EXPECT_TRUE(r.T_target_source.matrix().allFinite());
   EXPECT_LE(test::translationError(r.T_target_source, test::knownTransform()),
             test::translationError(Pose::Identity(), test::knownTransform()) + 1e-12);
