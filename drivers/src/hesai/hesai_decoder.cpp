@@ -153,7 +153,8 @@ void HesaiDecoder::decode(const UdpPacket& packet, DecodedPacket& out) {
       const auto seconds = hesai::utcSeconds(view.date, spec_.year_base);
       if (!seconds) {
         out.kind = DecodedPacket::Kind::kMalformed;
-        out.error = std::string(spec_.name) + " packet: date field " + std::to_string(spec_.year_base + view.date[0]) + "-" +
+        out.error = std::string(spec_.name) + " packet: date field " +
+                    std::to_string(spec_.year_base + view.date[0]) + "-" +
                     std::to_string(view.date[1]) + "-" + std::to_string(view.date[2]) + " " +
                     std::to_string(view.date[3]) + ":" + std::to_string(view.date[4]) + ":" +
                     std::to_string(view.date[5]) + " is not a valid UTC time";

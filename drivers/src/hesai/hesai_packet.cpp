@@ -449,7 +449,8 @@ std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> pay
     // The XT32M2X announces the most returns it can send (3), not the ones in this packet.
     const std::uint8_t most_returns = spec.model == Model::kXT32M ? 3 : 2;
     if (return_num < 1 || return_num > most_returns)
-      return fail(spec, "return_num " + std::to_string(return_num) + (most_returns == 2 ? ", expected 1 or 2" : ", expected 1 to 3"));
+      return fail(spec, "return_num " + std::to_string(return_num) +
+                            (most_returns == 2 ? ", expected 1 or 2" : ", expected 1 to 3"));
     v.body = p + kHeaderBytes;
     v.channels = spec.channels;
     v.blocks = spec.blocks;
