@@ -65,7 +65,8 @@ struct PacketRestamper::Impl {
   bool hesai(std::span<std::uint8_t> p, std::int64_t shift_us) const {
     hesai::PacketView v;
     if (!hesai::parsePacket(*hesai_spec, p, v).empty()) return false;
-    const int year_base = hesai_spec->year_base;  // Pandar40P counts years from 2000
+    // Pandar40P / Pandar64 count years from 2000 or 1900: the restamped packet keeps the original's way.
+    const int year_base = hesai::yearBase(*hesai_spec, v.date[0]);
     const auto seconds = hesai::utcSeconds(v.date, year_base);
     if (!seconds) return false;
     const std::int64_t t_us = *seconds * 1'000'000 + std::int64_t(v.timestamp_us) + shift_us;
@@ -73,7 +74,7 @@ struct PacketRestamper::Impl {
     const std::int64_t days = s >= 0 ? s / 86400 : (s - 86399) / 86400;
     const std::int64_t in_day = s - days * 86400;
     const CivilDate date = civilFromDays(days);
-    if (date.year < year_base || date.year > year_base + 255) return false;
+    if (date.year < year_base || date.year > year_base + (year_base == 2000 ? 99 : 255)) return false;
     auto* tail = p.data() + (v.tail - p.data());  // the same bytes, writable
     const std::size_t date_at = hesai::tailDateOffset(*hesai_spec);
     const std::uint8_t fields[6] = {std::uint8_t(date.year - year_base), std::uint8_t(date.month),

@@ -110,8 +110,9 @@ TEST(PacketRestamper, HesaiTailDateAndCrc) {
   EXPECT_GT(checked, 10);
 }
 
-// The older Hesai formats put the µs timestamp before the date, and the Pandar40P counts years from
-// 2000: a wrong offset or year base would move the decoded times by other than the shift.
+// The older Hesai formats put the µs timestamp before the date; the Pandar40P capture counts years from
+// 2000, the Pandar64 one from 1900: a wrong offset or year base would move the decoded times by other
+// than the shift.
 TEST(PacketRestamper, HesaiPandar40P64QT64AndXT32MTailTimes) {
   struct Case {
     const char* model;

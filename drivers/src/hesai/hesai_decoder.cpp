@@ -150,11 +150,11 @@ void HesaiDecoder::decode(const UdpPacket& packet, DecodedPacket& out) {
   TimeNs t0 = 0;
   if (time_source_ == TimeSource::kSensorClock) {
     if (view.date != cached_date_ || cached_seconds_ < 0) {
-      const auto seconds = hesai::utcSeconds(view.date, spec_.year_base);
+      const auto seconds = hesai::utcSeconds(view.date, hesai::yearBase(spec_, view.date[0]));
       if (!seconds) {
         out.kind = DecodedPacket::Kind::kMalformed;
         out.error = std::string(spec_.name) + " packet: date field " +
-                    std::to_string(spec_.year_base + view.date[0]) + "-" +
+                    std::to_string(hesai::yearBase(spec_, view.date[0]) + view.date[0]) + "-" +
                     std::to_string(view.date[1]) + "-" + std::to_string(view.date[2]) + " " +
                     std::to_string(view.date[3]) + ":" + std::to_string(view.date[4]) + ":" +
                     std::to_string(view.date[5]) + " is not a valid UTC time";

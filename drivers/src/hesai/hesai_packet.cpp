@@ -18,7 +18,7 @@ constexpr std::array<ModelSpec, 7> kModels{{
     {Model::kXT32, "PandarXT32", 6, 1, 32, 8, 0.05f, 120.0f, 256'000, Protocol::kXt61, 1900},
     {Model::kQT128, "PandarQT128", 3, 2, 128, 2, 0.05f, 50.0f, 172'800, Protocol::kQt32, 1900},
     {Model::kPandar40P, "Pandar40P", 0, 0, 40, 10, 0.3f, 200.0f, 288'000, Protocol::kPandar40P, 2000},
-    {Model::kPandar64, "Pandar64", 0, 0, 64, 6, 0.3f, 200.0f, 460'800, Protocol::kPandar64, 1900},
+    {Model::kPandar64, "Pandar64", 0, 0, 64, 6, 0.3f, 200.0f, 460'800, Protocol::kPandar64, 2000},
     {Model::kQT64, "PandarQT64", 3, 1, 64, 4, 0.1f, 60.0f, 76'800, Protocol::kQt31, 1900},
     {Model::kXT32M, "PandarXT32M", 6, 1, 32, 6, 0.5f, 300.0f, 256'000, Protocol::kXt61, 1900},
 }};
@@ -251,6 +251,10 @@ const TailLayout& tailLayout(const ModelSpec& spec) {
   return kXtTail;
 }
 }  // namespace
+
+int yearBase(const ModelSpec& spec, std::uint8_t year_byte) {
+  return spec.year_base == 2000 && year_byte >= 100 ? 1900 : spec.year_base;
+}
 
 std::size_t tailDateOffset(const ModelSpec& spec) { return tailLayout(spec).date; }
 std::size_t tailTimestampOffset(const ModelSpec& spec) { return tailLayout(spec).timestamp_us; }

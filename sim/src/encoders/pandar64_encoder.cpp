@@ -3,7 +3,8 @@
 //   header 8: 0xEE 0xFF, laser_num 64, block_num 6, reserved, dis_unit 4 (mm), 2 reserved
 //   6 blocks (one 55.56 µs firing round each): u16 azimuth (0.01°), 64 × {u16 distance, u8 reflectivity}
 //   tail 22: 5 reserved, high-temperature flag 0, 2 reserved, u16 motor rpm, u32 µs within the second,
-//     return mode 0x37, factory byte 0x42, date (year − 1900, month, day, hour, minute, second, UTC)
+//     return mode 0x37, factory byte 0x42, date (year − 1900 as the recorded unit sends it, month, day,
+//     hour, minute, second, UTC)
 //   u32 udp_sequence
 // The packet time (date + µs) is the time of block 6: block b's lasers fire 42.58 µs + 55.56 µs·(5 − b)
 // before it, each by its firing-time table entry earlier still (LidarModel::beams carry that table

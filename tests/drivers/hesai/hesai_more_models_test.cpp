@@ -62,7 +62,7 @@ TEST(HesaiMoreModels, RealPacketsParseWithTheirTailFields) {
   EXPECT_EQ(v.timestamp_us, 881567u);
   EXPECT_FALSE(v.udp_sequence);  // this unit sends the 1262-byte form, without the sequence
   // Year byte 17 counts from 2000: 2017-09-06 16:19:46 UTC.
-  EXPECT_EQ(utcSeconds(v.date, spec("Pandar40P").year_base), 1'504'714'786);
+  EXPECT_EQ(utcSeconds(v.date, yearBase(spec("Pandar40P"), v.date[0])), 1'504'714'786);
 
   p = firstPayload(p64);
   ASSERT_EQ(parsePacket(spec("Pandar64"), p, v), "");
@@ -72,7 +72,10 @@ TEST(HesaiMoreModels, RealPacketsParseWithTheirTailFields) {
   EXPECT_EQ(v.azimuth(0), 71);
   EXPECT_EQ(v.timestamp_us, 977341u);
   EXPECT_EQ(v.udp_sequence, 2339721u);
-  EXPECT_EQ(utcSeconds(v.date, spec("Pandar64").year_base), 1'593'086'529);  // 2020-06-25 12:02:09
+  // Year byte 120: this unit counts from 1900 (the manual says 2000): 2020-06-25 12:02:09 UTC.
+  EXPECT_EQ(utcSeconds(v.date, yearBase(spec("Pandar64"), v.date[0])), 1'593'086'529);
+  EXPECT_EQ(yearBase(spec("Pandar64"), 20), 2000);
+  EXPECT_EQ(yearBase(spec("PandarQT64"), 20), 1900);
   // Without the optional sequence (4 bytes shorter) the packet still parses.
   p.resize(p.size() - 4);
   ASSERT_EQ(parsePacket(spec("Pandar64"), p, v), "");

@@ -22,7 +22,7 @@
 //   tail 22 (reserved 5, high-temperature flag, reserved 2, motor rpm u16, µs timestamp u32,
 //   return mode, factory byte, date 6) | udp_sequence u32 (optional: told apart by the size).
 // Pandar40P (1262 or 1266 bytes): no header, 4 mm unit | 10 blocks × (0xFFEE, azimuth u16,
-//   40 × 3 bytes) | the Pandar64 tail | optional udp_sequence u32. Its date's year counts from 2000.
+//   40 × 3 bytes) | the Pandar64 tail | optional udp_sequence u32. Their date's year: yearBase().
 // XT32M (PandarXT32M2X, 820 bytes) is protocol 6.1 with 6 blocks; its header return_num says 3
 // (the most it can send), the tail's return mode says how many blocks one firing fills.
 // The three CRCs are CRC-32/MPEG-2. They are checked and counted, never a reason to drop a packet:
@@ -52,7 +52,7 @@ struct ModelSpec {
   float max_range_m;
   std::size_t max_points_per_scan;   // slowest rotation, dual return, every channel
   Protocol protocol;
-  std::uint16_t year_base;           // the tail date's year counts from this (1900, Pandar40P: 2000)
+  std::uint16_t year_base;           // the tail date's year counts from this (see yearBase())
 };
 
 /// The models this decoder reads, and lookup by exact name (nullptr when unknown).
@@ -129,6 +129,11 @@ std::int32_t qt128LoopOffsetNs(int loop, int channel);
 /// Seconds since the UNIX epoch of the tail date (year − year_base, month, day, hour, minute,
 /// second), independent of the local time zone; nullopt when a field is out of range.
 std::optional<std::int64_t> utcSeconds(const std::array<std::uint8_t, 6>& date, int year_base = 1900);
+
+/// The year the tail's year byte counts from. The Pandar40P and Pandar64 manuals say 2000, but units
+/// also send years since 1900 (the Pandar64 capture here says 120 for 2020): for those two a byte of
+/// 100 or more counts from 1900 (2000 onwards either way). Other models: 1900, as their manuals say.
+int yearBase(const ModelSpec& spec, std::uint8_t year_byte);
 
 /// Where the tail date (6 bytes) and the µs timestamp (u32) start in the tail of `spec`'s packets.
 std::size_t tailDateOffset(const ModelSpec& spec);
