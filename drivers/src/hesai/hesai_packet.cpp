@@ -12,13 +12,14 @@ namespace rigcal::drivers::hesai {
 namespace {
 
 // Range limits of the newer models are the ones nebula applies (the references were made with them).
-// max_points_per_scan: slowest rotation (5 Hz where the model has it), dual return, every channel.
+// max_points_per_scan: slowest rotation (10 Hz for the 40P, 64 and QT64; 5 Hz for the XT32M), dual
+// return, every channel.
 constexpr std::array<ModelSpec, 7> kModels{{
     {Model::kXT16, "PandarXT16", 6, 1, 16, 8, 0.05f, 120.0f, 128'000, Protocol::kXt61, 1900},
     {Model::kXT32, "PandarXT32", 6, 1, 32, 8, 0.05f, 120.0f, 256'000, Protocol::kXt61, 1900},
     {Model::kQT128, "PandarQT128", 3, 2, 128, 2, 0.05f, 50.0f, 172'800, Protocol::kQt32, 1900},
-    {Model::kPandar40P, "Pandar40P", 0, 0, 40, 10, 0.3f, 200.0f, 288'000, Protocol::kPandar40P, 2000},
-    {Model::kPandar64, "Pandar64", 0, 0, 64, 6, 0.3f, 200.0f, 460'800, Protocol::kPandar64, 2000},
+    {Model::kPandar40P, "Pandar40P", 0, 0, 40, 10, 0.3f, 200.0f, 144'000, Protocol::kPandar40P, 2000},
+    {Model::kPandar64, "Pandar64", 0, 0, 64, 6, 0.3f, 200.0f, 230'400, Protocol::kPandar64, 2000},
     {Model::kQT64, "PandarQT64", 3, 1, 64, 4, 0.1f, 60.0f, 76'800, Protocol::kQt31, 1900},
     {Model::kXT32M, "PandarXT32M", 6, 1, 32, 6, 0.5f, 300.0f, 256'000, Protocol::kXt61, 1900},
 }};
