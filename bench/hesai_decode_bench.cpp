@@ -27,3 +27,7 @@ void decodeBench(benchmark::State& state, const char* model, const char* capture
 HESAI_BENCH(PandarXT32_dual, "PandarXT32", "xt32_dual.pcap", "PandarXT32.csv");
 HESAI_BENCH(PandarXT16_dual, "PandarXT16", "xt16_dual.pcap", "PandarXT16.csv");
 HESAI_BENCH(PandarQT128_dual, "PandarQT128", "qt128_laststrongest.pcap", "PandarQT128.csv");
+HESAI_BENCH(Pandar40P_dual, "Pandar40P", "pandar40p_dual.pcap", "Pandar40P.csv");
+HESAI_BENCH(Pandar64_dual, "Pandar64", "pandar64_dual.pcap", "Pandar64.csv");
+HESAI_BENCH(PandarQT64_dual, "PandarQT64", "pandarqt64_dual.pcap", "PandarQT64.csv");
+HESAI_BENCH(PandarXT32M_laststrongest, "PandarXT32M", "xt32m_laststrongest.pcap", "PandarXT32M.csv");

@@ -1,5 +1,5 @@
 // libFuzzer harness: feeds a sequence of packets to a Hesai decoder (fresh per input).
-// Input: byte 0 selects the model (mod 3), byte 1 options (bit 0: host-receive time, bit 1: repair
+// Input: byte 0 selects the model (mod the number of models), byte 1 options (bit 0: host-receive time, bit 1: repair
 // each packet's header and size so that the body and tail get explored), then packets as
 // [length u16 little endian][bytes]. After the packets the decoder is flushed.
 #include <cstddef>
@@ -24,12 +24,31 @@ hesai::Calibration calibrationFor(const hesai::ModelSpec& spec) {
 }
 
 std::size_t expectedSize(const hesai::ModelSpec& spec) {
-  return spec.model == hesai::Model::kQT128 ? 1127 : 12 + spec.blocks * (2 + 4 * spec.channels) + 28;
+  switch (spec.protocol) {
+    case hesai::Protocol::kQt32: return 1127;
+    case hesai::Protocol::kPandar40P: return spec.blocks * (4 + 3 * spec.channels) + 22;
+    case hesai::Protocol::kPandar64: return 8 + spec.blocks * (2 + 3 * spec.channels) + 26;
+    case hesai::Protocol::kQt31:
+    case hesai::Protocol::kXt61: break;
+  }
+  return 12 + spec.blocks * (2 + 4 * spec.channels) + 28;
 }
 
 void repair(const hesai::ModelSpec& spec, std::vector<std::uint8_t>& p) {
   p.resize(expectedSize(spec), 0);
-  p[0] = 0xEE, p[1] = 0xFF, p[2] = spec.protocol_major, p[3] = spec.protocol_minor;
+  if (spec.protocol == hesai::Protocol::kPandar40P) {
+    for (std::size_t b = 0; b < spec.blocks; ++b) {
+      const std::size_t at = b * (4 + 3 * std::size_t(spec.channels));
+      p[at] = 0xFF, p[at + 1] = 0xEE;
+    }
+    return;
+  }
+  p[0] = 0xEE, p[1] = 0xFF;
+  if (spec.protocol == hesai::Protocol::kPandar64) {
+    p[2] = static_cast<std::uint8_t>(spec.channels), p[3] = static_cast<std::uint8_t>(spec.blocks);
+    return;
+  }
+  p[2] = spec.protocol_major, p[3] = spec.protocol_minor;
   p[6] = static_cast<std::uint8_t>(spec.channels), p[7] = static_cast<std::uint8_t>(spec.blocks);
   p[11] = spec.model == hesai::Model::kQT128 ? 0x1D : 0x01;
 }

@@ -65,20 +65,23 @@ struct PacketRestamper::Impl {
   bool hesai(std::span<std::uint8_t> p, std::int64_t shift_us) const {
     hesai::PacketView v;
     if (!hesai::parsePacket(*hesai_spec, p, v).empty()) return false;
-    const auto seconds = hesai::utcSeconds(v.date);
+    // Pandar40P / Pandar64 count years from 2000 or 1900: the restamped packet keeps the original's way.
+    const int year_base = hesai::yearBase(*hesai_spec, v.date[0]);
+    const auto seconds = hesai::utcSeconds(v.date, year_base);
     if (!seconds) return false;
     const std::int64_t t_us = *seconds * 1'000'000 + std::int64_t(v.timestamp_us) + shift_us;
     const std::int64_t s = t_us >= 0 ? t_us / 1'000'000 : (t_us - 999'999) / 1'000'000;
     const std::int64_t days = s >= 0 ? s / 86400 : (s - 86399) / 86400;
     const std::int64_t in_day = s - days * 86400;
     const CivilDate date = civilFromDays(days);
-    if (date.year < 1900 || date.year > 1900 + 255) return false;
+    if (date.year < year_base || date.year > year_base + (year_base == 2000 ? 99 : 255)) return false;
     auto* tail = p.data() + (v.tail - p.data());  // the same bytes, writable
     const std::size_t date_at = hesai::tailDateOffset(*hesai_spec);
-    const std::uint8_t fields[6] = {std::uint8_t(date.year - 1900), std::uint8_t(date.month), std::uint8_t(date.day),
-                                    std::uint8_t(in_day / 3600), std::uint8_t(in_day / 60 % 60), std::uint8_t(in_day % 60)};
+    const std::uint8_t fields[6] = {std::uint8_t(date.year - year_base), std::uint8_t(date.month),
+                                    std::uint8_t(date.day),           std::uint8_t(in_day / 3600),
+                                    std::uint8_t(in_day / 60 % 60),   std::uint8_t(in_day % 60)};
     std::memcpy(tail + date_at, fields, 6);
-    store(tail + date_at + 6, std::uint32_t(t_us - s * 1'000'000));
+    store(tail + hesai::tailTimestampOffset(*hesai_spec), std::uint32_t(t_us - s * 1'000'000));
     if (v.tail_crc_bytes > 0)
       store(tail + v.tail_crc_bytes, hesai::crc32Mpeg2({tail, v.tail_crc_bytes}));
     return true;

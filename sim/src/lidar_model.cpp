@@ -44,6 +44,7 @@ const std::vector<LidarModel>& registry() {
     m.push_back(detail::makeOs1_64());
     m.push_back(detail::makeOs1_128());
     m.push_back(detail::makePandarXt32());
+    m.push_back(detail::makePandar64());
     return m;
   }();
   return models;

@@ -110,6 +110,28 @@ TEST(PacketRestamper, HesaiTailDateAndCrc) {
   EXPECT_GT(checked, 10);
 }
 
+// The older Hesai formats put the µs timestamp before the date; the Pandar40P capture counts years from
+// 2000, the Pandar64 one from 1900: a wrong offset or year base would move the decoded times by other
+// than the shift.
+TEST(PacketRestamper, HesaiPandar40P64QT64AndXT32MTailTimes) {
+  struct Case {
+    const char* model;
+    const char* capture;
+    const char* calibration;
+  };
+  int n = 0;
+  for (const Case& k : {Case{"Pandar40P", "hesai/pandar40p_dual.pcap", "hesai/Pandar40P.csv"},
+                        Case{"Pandar64", "hesai/pandar64_dual.pcap", "hesai/Pandar64.csv"},
+                        Case{"PandarQT64", "hesai/pandarqt64_dual.pcap", "hesai/PandarQT64.csv"},
+                        Case{"PandarXT32M", "hesai/xt32m_laststrongest.pcap", "hesai/PandarXT32M.csv"}}) {
+    RIGCAL_REQUIRE_DATA(pcap, k.capture);
+    DecoderConfig c;
+    c.model = k.model;
+    c.calibration = test::dataDir() / k.calibration;
+    EXPECT_GT(checkShift(pcap, c, (n++ % 2) ? -kShiftUs : kShiftUs).data, 500) << k.model;
+  }
+}
+
 TEST(PacketRestamper, ForeignPacketsAndUnknownModelsAreLeftAlone) {
   DecoderConfig c;
   c.model = "VLP-16";

@@ -83,7 +83,8 @@ TEST_P(RoundTrip, DecodersGiveBackTheSimulatedPointsWithinQuantisation) {
 INSTANTIATE_TEST_SUITE_P(Models, RoundTrip,
                          ::testing::Values(ModelCase{"VLP-16", 0.02}, ModelCase{"OS1-64", 0.001},
                                            ModelCase{"VLP-32C", 0.02}, ModelCase{"VLS-128", 0.02},
-                                           ModelCase{"OS1-128", 0.001}, ModelCase{"PandarXT32", 0.01}),
+                                           ModelCase{"OS1-128", 0.001}, ModelCase{"PandarXT32", 0.01},
+                                           ModelCase{"Pandar64", 0.01}),
                          [](const ::testing::TestParamInfo<ModelCase>& param_info) {
                            std::string n = param_info.param.model;
                            std::erase(n, '-');
@@ -110,7 +111,7 @@ Pose poseFrom(const YAML::Node& n) {
 // that does come back is the simulated one.
 TEST(RoundTripCapture, AnOutageIsSeenAsLostPacketsByEveryVendor) {
   constexpr double kOutageFrom = RIGCAL_SANITIZED ? 0.05 : 0.2;
-  for (const char* model : {"VLP-16", "OS1-64", "PandarXT32"}) {
+  for (const char* model : {"VLP-16", "OS1-64", "PandarXT32", "Pandar64"}) {
     const Scenario sc = parseScenario(std::string("scenario: outage\nseed: 4\nrig:\n  mapping_lidar: l\n  sensors:\n"
                                                   "    - {name: l, model: ") + model +
                                           ", address: 10.0.0.2, port: 2368, extrinsic: {z: 1.9}, "

@@ -121,7 +121,11 @@ Calibration nominalCalibration(const ModelSpec& spec) {
     case Model::kXT32:
       for (int i = 0; i < 32; ++i) cal.elevation_deg.push_back(15.0 - 1.0 * i);
       break;
-    case Model::kQT128:
+    case Model::kQT128:  // no nominal table here: these need their angle-correction file
+    case Model::kPandar40P:
+    case Model::kPandar64:
+    case Model::kQT64:
+    case Model::kXT32M:
       throw std::runtime_error(std::string(spec.name) +
                                ": an angle-correction CSV is required (DecoderConfig::calibration is empty)");
   }

@@ -150,10 +150,11 @@ void HesaiDecoder::decode(const UdpPacket& packet, DecodedPacket& out) {
   TimeNs t0 = 0;
   if (time_source_ == TimeSource::kSensorClock) {
     if (view.date != cached_date_ || cached_seconds_ < 0) {
-      const auto seconds = hesai::utcSeconds(view.date);
+      const auto seconds = hesai::utcSeconds(view.date, hesai::yearBase(spec_, view.date[0]));
       if (!seconds) {
         out.kind = DecodedPacket::Kind::kMalformed;
-        out.error = std::string(spec_.name) + " packet: date field " + std::to_string(1900 + view.date[0]) + "-" +
+        out.error = std::string(spec_.name) + " packet: date field " +
+                    std::to_string(hesai::yearBase(spec_, view.date[0]) + view.date[0]) + "-" +
                     std::to_string(view.date[1]) + "-" + std::to_string(view.date[2]) + " " +
                     std::to_string(view.date[3]) + ":" + std::to_string(view.date[4]) + ":" +
                     std::to_string(view.date[5]) + " is not a valid UTC time";
@@ -239,13 +240,14 @@ void HesaiDecoder::decodeGroup(const hesai::PacketView& view, int first_block, s
   const std::size_t az_index = static_cast<std::size_t>(unwrapped % kUnitsPerTurn);
   const float ca = cos_az_[az_index], sa = sin_az_[az_index];
   const float scale = static_cast<float>(limits.scale);
-  const std::uint8_t* blocks[2] = {view.block(first_block) + 2, view.block(first_block + kReturns - 1) + 2};
+  const std::uint8_t* blocks[2] = {view.units(first_block), view.units(first_block + kReturns - 1)};
+  const std::size_t stride = view.unit_bytes;
   for (int j = 0; j < channels_; ++j) {
     const int c = order_[j];
     std::uint32_t raw[kReturns];
     std::uint32_t any = 0;
     for (int k = 0; k < kReturns; ++k) {
-      const std::uint8_t* u = blocks[k] + 4 * c;
+      const std::uint8_t* u = blocks[k] + stride * c;
       raw[k] = static_cast<std::uint32_t>(u[0] | (u[1] << 8));
       any |= raw[k];
     }
@@ -268,7 +270,7 @@ void HesaiDecoder::decodeGroup(const hesai::PacketView& view, int first_block, s
       p.x = d * (cx * ca - sx * sa);
       p.y = -d * (cx * sa + sx * ca);
       p.z = d * z_sin_[j];
-      p.intensity = blocks[k][4 * c + 2];
+      p.intensity = blocks[k][stride * c + 2];
       p.ring = static_cast<std::uint16_t>(c);
       p.time_ns = t0 + times[c];
       p.return_index = static_cast<std::uint8_t>(k);

@@ -11,10 +11,17 @@
 namespace rigcal::drivers::hesai {
 namespace {
 
-constexpr std::array<ModelSpec, 3> kModels{{
-    {Model::kXT16, "PandarXT16", 6, 1, 16, 8, 0.05f, 120.0f, 128'000},
-    {Model::kXT32, "PandarXT32", 6, 1, 32, 8, 0.05f, 120.0f, 256'000},
-    {Model::kQT128, "PandarQT128", 3, 2, 128, 2, 0.05f, 50.0f, 172'800},
+// Range limits of the newer models are the ones nebula applies (the references were made with them).
+// max_points_per_scan: slowest rotation (10 Hz for the 40P, 64 and QT64; 5 Hz for the XT32M), dual
+// return, every channel.
+constexpr std::array<ModelSpec, 7> kModels{{
+    {Model::kXT16, "PandarXT16", 6, 1, 16, 8, 0.05f, 120.0f, 128'000, Protocol::kXt61, 1900},
+    {Model::kXT32, "PandarXT32", 6, 1, 32, 8, 0.05f, 120.0f, 256'000, Protocol::kXt61, 1900},
+    {Model::kQT128, "PandarQT128", 3, 2, 128, 2, 0.05f, 50.0f, 172'800, Protocol::kQt32, 1900},
+    {Model::kPandar40P, "Pandar40P", 0, 0, 40, 10, 0.3f, 200.0f, 144'000, Protocol::kPandar40P, 2000},
+    {Model::kPandar64, "Pandar64", 0, 0, 64, 6, 0.3f, 200.0f, 230'400, Protocol::kPandar64, 2000},
+    {Model::kQT64, "PandarQT64", 3, 1, 64, 4, 0.1f, 60.0f, 76'800, Protocol::kQt31, 1900},
+    {Model::kXT32M, "PandarXT32M", 6, 1, 32, 6, 0.5f, 300.0f, 256'000, Protocol::kXt61, 1900},
 }};
 
 constexpr std::size_t kHeaderBytes = 12;
@@ -30,7 +37,34 @@ struct TailLayout {
 };
 constexpr TailLayout kXtTail{10, 11, 13, 19};
 constexpr TailLayout kQtTail{12, 13, 15, 21};
-static_assert(kXtTail.timestamp_us == kXtTail.date + 6 && kQtTail.timestamp_us == kQtTail.date + 6);
+// The older formats put the µs timestamp before the return mode and the date last.
+constexpr std::size_t kQt64TailBytes = 24;
+constexpr TailLayout kQt64Tail{16, 10, 18, 12};
+constexpr std::size_t kLegacyTailBytes = 22;  // Pandar64 and Pandar40P
+constexpr TailLayout kLegacyTail{14, 8, 16, 10};
+constexpr std::size_t kPandar64HeaderBytes = 8;
+
+// Firing time of each channel (index = channel − 1) after its block's start, ns, from the firing-time
+// tables of the Pandar40P and Pandar64 user manuals (negative: the laser fires before the block
+// time), and of the PandarQT64 manual. The QT64 entry of channel 56 is 129.60 µs: the table as
+// reproduced in nebula has 12.96 µs, a dropped digit (its neighbours are 2.06 µs apart).
+constexpr std::array<std::int32_t, 40> kPandar40PChannelNs{
+    -42220, -28470, -16040, -3620,  -45490, -31740, -47460, -54670, -20620, -33710,
+    -40910, -8190,  -20620, -27160, -50730, -8190,  -14740, -36980, -45490, -52700,
+    -23890, -31740, -38950, -11470, -18650, -25190, -48760, -6230,  -12770, -35010,
+    -21920, -9500,  -43520, -29770, -17350, -4920,  -42220, -28470, -16040, -3620};
+constexpr std::array<std::int32_t, 64> kPandar64ChannelNs{
+    -23180, -21876, -20572, -19268, -17964, -16660, -11444, -46796, -7532,  -36956, -50732, -54668, -40892,
+    -44828, -31052, -34988, -48764, -52700, -38924, -42860, -29084, -33020, -46796, -25148, -36956, -50732,
+    -27116, -40892, -44828, -31052, -34988, -48764, -25148, -38924, -42860, -29084, -33020, -52700, -6228,
+    -54668, -15356, -27116, -10140, -23180, -4924,  -21876, -14052, -17964, -8836,  -19268, -3620,  -20572,
+    -12748, -16660, -7532,  -11444, -6228,  -15356, -10140, -4924,  -3620,  -14052, -8836,  -12748};
+constexpr std::array<std::int32_t, 64> kQt64ChannelNs{
+    12310,  14370,  16430,  18490,  20540,  22600,  24660,  26710,  29160,  31220,  33280,  35340,  37390,
+    39450,  41500,  43560,  46610,  48670,  50730,  52780,  54840,  56900,  58950,  61010,  63450,  65520,
+    67580,  69630,  71690,  73740,  75800,  77860,  80900,  82970,  85020,  87080,  89140,  91190,  93250,
+    95300,  97750,  99820,  101870, 103930, 105980, 108040, 110100, 112150, 115200, 117260, 119320, 121380,
+    123430, 125490, 127540, 129600, 132050, 134110, 136170, 138220, 140280, 142340, 144390, 146450};
 
 // QT128C2X firing sequences (Hesai QT128C2X user manual, Appendix "Absolute Time of Point Cloud
 // Data", firetime table): offset of each channel (index = channel − 1) in ns from the start of its
@@ -198,17 +232,33 @@ std::uint32_t crc32Mpeg2(std::span<const std::uint8_t> bytes) {
   return crcTable(0xFFFFFFFFu, bytes.data(), bytes.size());
 }
 
-std::optional<std::int64_t> utcSeconds(const std::array<std::uint8_t, 6>& d) {
+std::optional<std::int64_t> utcSeconds(const std::array<std::uint8_t, 6>& d, int year_base) {
   const unsigned month = d[1], day = d[2], hour = d[3], minute = d[4], second = d[5];
   if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 || second > 60)
     return std::nullopt;
-  const std::int64_t days = daysFromCivil(1900 + std::int64_t(d[0]), month, day);
+  const std::int64_t days = daysFromCivil(year_base + std::int64_t(d[0]), month, day);
   return days * 86400 + hour * 3600 + minute * 60 + second;
 }
 
-std::size_t tailDateOffset(const ModelSpec& spec) {
-  return spec.protocol_major == 6 ? kXtTail.date : kQtTail.date;
+namespace {
+const TailLayout& tailLayout(const ModelSpec& spec) {
+  switch (spec.protocol) {
+    case Protocol::kXt61: return kXtTail;
+    case Protocol::kQt32: return kQtTail;
+    case Protocol::kQt31: return kQt64Tail;
+    case Protocol::kPandar64:
+    case Protocol::kPandar40P: return kLegacyTail;
+  }
+  return kXtTail;
 }
+}  // namespace
+
+int yearBase(const ModelSpec& spec, std::uint8_t year_byte) {
+  return spec.year_base == 2000 && year_byte >= 100 ? 1900 : spec.year_base;
+}
+
+std::size_t tailDateOffset(const ModelSpec& spec) { return tailLayout(spec).date; }
+std::size_t tailTimestampOffset(const ModelSpec& spec) { return tailLayout(spec).timestamp_us; }
 
 std::int32_t qt128LoopOffsetNs(int loop, int channel) {
   if (channel < 0 || channel >= 128) return 0;
@@ -219,12 +269,30 @@ std::int64_t firingOffsetNs(Model model, int returns, int block, int channel, st
   returns = returns == 2 ? 2 : 1;
   switch (model) {
     case Model::kXT16:
-    case Model::kXT32: {
+    case Model::kXT32:
+    case Model::kXT32M: {
       // Firing rounds are 50 µs apart; t0 is the trigger of the last round (block 8, or 7 & 8).
-      const int rounds_after = (8 / returns - 1) - block / returns;
+      const int blocks = model == Model::kXT32M ? 6 : 8;
+      const int rounds_after = (blocks / returns - 1) - block / returns;
       const std::int64_t block_start = 5'632 - 50'000 * std::int64_t(rounds_after);
+      if (model == Model::kXT32M) return block_start + 368 + 2'888 * (channel % 16);
       const std::int64_t step = model == Model::kXT32 ? 1'512 : 3'024;
       return block_start + 368 + step * channel;
+    }
+    case Model::kPandar40P:
+    case Model::kPandar64: {
+      // Firing rounds are 55.56 µs apart; t0 is the time of the last round.
+      const bool p40 = model == Model::kPandar40P;
+      const int rounds_after = ((p40 ? 10 : 6) / returns - 1) - block / returns;
+      const std::int64_t block_start = (p40 ? -28'580 : -42'580) - 55'560 * std::int64_t(rounds_after);
+      if (channel < 0 || channel >= (p40 ? 40 : 64)) return block_start;
+      return block_start + (p40 ? kPandar40PChannelNs[channel] : kPandar64ChannelNs[channel]);
+    }
+    case Model::kQT64: {
+      // Firing rounds are 166.67 µs apart; t0 is the time of the packet's first round.
+      const std::int64_t block_start = 25'710 + 500'000 * std::int64_t(block / returns) / 3;
+      if (channel < 0 || channel >= 64) return block_start;
+      return block_start + kQt64ChannelNs[channel];
     }
     case Model::kQT128: {
       // One firing round is 111.11 µs (900 rounds per turn at 10 Hz).
@@ -236,32 +304,14 @@ std::int64_t firingOffsetNs(Model model, int returns, int block, int channel, st
   return 0;
 }
 
-std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> payload, PacketView& v) {
+namespace {
+
+// Protocols 6.1 (XT) and 3.2 (QT128): everything after the 12-byte header (already checked).
+std::string parseXtOrQt128(const ModelSpec& spec, std::span<const std::uint8_t> payload, PacketView& v) {
   const std::size_t size = payload.size();
   const std::uint8_t* p = payload.data();
-  if (size < kHeaderBytes)
-    return fail(spec, "size " + std::to_string(size) + ", shorter than the 12-byte header");
-  if (p[0] != 0xEE || p[1] != 0xFF)
-    return fail(spec, "start of packet " + hex(unsigned(p[0]) << 8 | p[1], 4) + ", expected 0xEEFF");
-  if (p[2] != spec.protocol_major || p[3] != spec.protocol_minor)
-    return fail(spec, "protocol version " + std::to_string(p[2]) + "." + std::to_string(p[3]) +
-                          ", expected " + std::to_string(spec.protocol_major) + "." +
-                          std::to_string(spec.protocol_minor));
-  if (p[6] != spec.channels)
-    return fail(spec, "laser_num " + std::to_string(p[6]) + ", expected " + std::to_string(spec.channels));
-  if (p[7] != spec.blocks)
-    return fail(spec, "block_num " + std::to_string(p[7]) + ", expected " + std::to_string(spec.blocks));
-  if (p[9] == 0) return fail(spec, "dis_unit 0");
-  const std::uint8_t return_num = p[10];
-  if (return_num != 1 && return_num != 2)
-    return fail(spec, "return_num " + std::to_string(return_num) + ", expected 1 or 2");
   const std::uint8_t flags = p[11];
 
-  v.body = p + kHeaderBytes;
-  v.channels = spec.channels;
-  v.blocks = spec.blocks;
-  v.returns = return_num;
-  v.dis_unit_mm = p[9];
   const std::size_t body_bytes = std::size_t(spec.blocks) * v.blockBytes();
   const std::size_t body_end = kHeaderBytes + body_bytes;
 
@@ -308,11 +358,124 @@ std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> pay
     v.crc_ok = ok;
   }
 
+  return {};
+}
+
+// The Pandar40P and Pandar64 formats: no protocol version, a fixed 4 mm unit (Pandar40P) or the
+// header's, 3-byte units, the return count from the tail only, an optional trailing udp_sequence.
+std::string parseLegacy(const ModelSpec& spec, std::span<const std::uint8_t> payload, PacketView& v) {
+  const std::size_t size = payload.size();
+  const std::uint8_t* p = payload.data();
+  const bool p40 = spec.protocol == Protocol::kPandar40P;
+  const std::size_t header = p40 ? 0 : kPandar64HeaderBytes;
+  v.channels = spec.channels;
+  v.blocks = spec.blocks;
+  v.block_prefix = p40 ? 4 : 2;
+  v.unit_bytes = 3;
+  const std::size_t body_end = header + std::size_t(spec.blocks) * v.blockBytes();
+  const std::size_t bare = body_end + kLegacyTailBytes;
+  if (size != bare && size != bare + 4)
+    return fail(spec, "size " + std::to_string(size) + ", expected " + std::to_string(bare) + " or " +
+                          std::to_string(bare + 4) + " (with udp_sequence)");
+  if (p40) {
+    v.dis_unit_mm = 4;
+  } else {
+    if (p[0] != 0xEE || p[1] != 0xFF)
+      return fail(spec, "start of packet " + hex(unsigned(p[0]) << 8 | p[1], 4) + ", expected 0xEEFF");
+    if (p[2] != spec.channels)
+      return fail(spec, "laser_num " + std::to_string(p[2]) + ", expected " + std::to_string(spec.channels));
+    if (p[3] != spec.blocks)
+      return fail(spec, "block_num " + std::to_string(p[3]) + ", expected " + std::to_string(spec.blocks));
+    if (p[5] == 0) return fail(spec, "dis_unit 0");
+    v.dis_unit_mm = p[5];
+  }
+  v.body = p + header;
+  if (p40)
+    for (int b = 0; b < spec.blocks; ++b) {
+      const std::uint8_t* block = v.block(b);
+      if (block[0] != 0xFF || block[1] != 0xEE)
+        return fail(spec, "block " + std::to_string(b + 1) + " starts " + hex(unsigned(block[0]) << 8 | block[1], 4) +
+                              ", expected 0xFFEE");
+    }
+  v.tail = p + body_end;
+  readTail(v.tail, kLegacyTail, v);
+  v.udp_sequence.reset();
+  if (size == bare + 4) v.udp_sequence = u32(v.tail + kLegacyTailBytes);
+  return {};
+}
+
+// Protocol 3.1 (QT64): a 12-byte header, 4-byte units, no CRC.
+std::string parseQt31(const ModelSpec& spec, std::span<const std::uint8_t> payload, PacketView& v) {
+  const std::uint8_t* p = payload.data();
+  const std::uint8_t flags = p[11];
+  if (flags & ~0x01u) return fail(spec, "flags " + hex(flags, 2) + " announce fields this decoder does not know");
+  const bool has_sequence = flags & 0x01;
+  const std::size_t body_end = kHeaderBytes + std::size_t(spec.blocks) * v.blockBytes();
+  const std::size_t expected = body_end + kQt64TailBytes + (has_sequence ? 4 : 0);
+  if (payload.size() != expected)
+    return fail(spec, "size " + std::to_string(payload.size()) + ", expected " + std::to_string(expected) +
+                          " for flags " + hex(flags, 2));
+  v.tail = p + body_end;
+  readTail(v.tail, kQt64Tail, v);
+  v.udp_sequence.reset();
+  if (has_sequence) v.udp_sequence = u32(v.tail + kQt64TailBytes);
+  return {};
+}
+
+}  // namespace
+
+std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> payload, PacketView& v) {
+  const std::size_t size = payload.size();
+  const std::uint8_t* p = payload.data();
+  v.mode_flag = 0;
+  v.has_crc = false;
+  v.crc_ok = true;
+  v.tail_crc_bytes = 0;
+  v.block_prefix = 2;
+  v.unit_bytes = 4;
+  std::uint8_t return_num = 0;  // the header's return count, where the format has one
+  if (spec.protocol == Protocol::kPandar40P || spec.protocol == Protocol::kPandar64) {
+    if (std::string error = parseLegacy(spec, payload, v); !error.empty()) return error;
+  } else {
+    if (size < kHeaderBytes)
+      return fail(spec, "size " + std::to_string(size) + ", shorter than the 12-byte header");
+    if (p[0] != 0xEE || p[1] != 0xFF)
+      return fail(spec, "start of packet " + hex(unsigned(p[0]) << 8 | p[1], 4) + ", expected 0xEEFF");
+    if (p[2] != spec.protocol_major || p[3] != spec.protocol_minor)
+      return fail(spec, "protocol version " + std::to_string(p[2]) + "." + std::to_string(p[3]) +
+                            ", expected " + std::to_string(spec.protocol_major) + "." +
+                            std::to_string(spec.protocol_minor));
+    if (p[6] != spec.channels)
+      return fail(spec, "laser_num " + std::to_string(p[6]) + ", expected " + std::to_string(spec.channels));
+    if (p[7] != spec.blocks)
+      return fail(spec, "block_num " + std::to_string(p[7]) + ", expected " + std::to_string(spec.blocks));
+    if (p[9] == 0) return fail(spec, "dis_unit 0");
+    return_num = p[10];
+    // The XT32M2X announces the most returns it can send (3), not the ones in this packet.
+    const std::uint8_t most_returns = spec.model == Model::kXT32M ? 3 : 2;
+    if (return_num < 1 || return_num > most_returns)
+      return fail(spec, "return_num " + std::to_string(return_num) +
+                            (most_returns == 2 ? ", expected 1 or 2" : ", expected 1 to 3"));
+    v.body = p + kHeaderBytes;
+    v.channels = spec.channels;
+    v.blocks = spec.blocks;
+    v.dis_unit_mm = p[9];
+    if (spec.protocol == Protocol::kQt31) {
+      if (std::string error = parseQt31(spec, payload, v); !error.empty()) return error;
+    } else if (std::string error = parseXtOrQt128(spec, payload, v); !error.empty()) {
+      return error;
+    }
+  }
+
   const int n = returnsPerFiring(v.return_mode);
   if (n == 0) return fail(spec, "return mode " + hex(v.return_mode, 2) + " unknown");
-  if (n != return_num)
+  if (return_num != 0 && spec.model != Model::kXT32M && n != return_num)
     return fail(spec, "return mode " + hex(v.return_mode, 2) + " has " + std::to_string(n) +
                           " returns, header return_num " + std::to_string(return_num));
+  if (spec.blocks % n != 0)
+    return fail(spec, "return mode " + hex(v.return_mode, 2) + " does not fit " + std::to_string(spec.blocks) +
+                          " blocks");
+  v.returns = static_cast<std::uint8_t>(n);
   if (v.timestamp_us > 1'000'000)
     return fail(spec, "timestamp " + std::to_string(v.timestamp_us) + " us, above 1000000");
   for (int b = 0; b < v.blocks; ++b) {

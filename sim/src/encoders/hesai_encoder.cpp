@@ -112,6 +112,7 @@ class HesaiXt32Encoder final : public PacketEncoder {
 }  // namespace
 
 std::unique_ptr<PacketEncoder> makeHesaiEncoder(const LidarModel& model, const EncoderConfig& config) {
+  if (model.name == "Pandar64") return makePandar64Encoder(model, config);
   if (model.name != "PandarXT32") return nullptr;
   if (model.beamCount() != 32 || model.distance_unit_m != 0.004)
     throw std::invalid_argument(model.name + ": the protocol 6.1 encoder needs 32 channels in 4 mm units");

@@ -36,7 +36,8 @@ DecodedPacket decodeAlone(HesaiDecoder& decoder, const UdpPacket& packet) {
 }
 
 TEST(HesaiDecoder, FactoryModelsAndErrors) {
-  EXPECT_EQ(hesaiModels(), (std::vector<std::string>{"PandarXT16", "PandarXT32", "PandarQT128"}));
+  EXPECT_EQ(hesaiModels(), (std::vector<std::string>{"PandarXT16", "PandarXT32", "PandarQT128", "Pandar40P",
+                                                     "Pandar64", "PandarQT64", "PandarXT32M"}));
   try {
     makeHesaiDecoder(configFor("PandarXT64"));
     FAIL();

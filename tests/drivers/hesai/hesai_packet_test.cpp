@@ -24,7 +24,7 @@ std::vector<std::uint8_t> firstPayload(const std::filesystem::path& file) {
 }
 
 TEST(HesaiPacket, ModelsAndReturnModes) {
-  ASSERT_EQ(allModels().size(), 3u);
+  ASSERT_EQ(allModels().size(), 7u);
   EXPECT_EQ(findModel("PandarXT32")->channels, 32);
   EXPECT_EQ(findModel("PandarXT16")->channels, 16);
   EXPECT_EQ(findModel("PandarQT128")->channels, 128);

@@ -93,6 +93,11 @@ LidarModel makeVls128();
 LidarModel makeOs1_64();
 LidarModel makeOs1_128();
 LidarModel makePandarXt32();
+LidarModel makePandar64();
+// Pandar64 timing shared by its model and encoder: one firing round, and how long before the round's
+// block time its earliest laser fires (the manual's table starts at −54.668 µs).
+inline constexpr std::int64_t kPandar64RoundNs = 55'560;
+inline constexpr std::int64_t kPandar64EarliestNs = 54'668;
 }  // namespace detail
 
 }  // namespace rigcal::sim

@@ -1,5 +1,6 @@
 #pragma once
-// Hesai PandarXT16, PandarXT32 (protocol 6.1) and PandarQT128 (QT128C2X, protocol 3.2) decoder.
+// Hesai decoder: PandarXT16, PandarXT32, PandarXT32M (protocol 6.1), PandarQT128 (QT128C2X, protocol
+// 3.2), PandarQT64 (protocol 3.1), Pandar64 and Pandar40P (formats in hesai_packet.hpp).
 //
 // Axes: Hesai's native frame has y forward and x to the right (x_h = r·cosω·sin(az),
 // y_h = r·cosω·cos(az), z_h = r·sinω, az clockwise seen from above). Ours is x forward, y left,
@@ -98,7 +99,7 @@ class HesaiDecoder final : public PacketDecoder {
 
 /// The factory for the generic makeDecoder.
 std::unique_ptr<PacketDecoder> makeHesaiDecoder(const DecoderConfig& config);
-/// "PandarXT16", "PandarXT32", "PandarQT128".
+/// "PandarXT16", "PandarXT32", "PandarQT128", "Pandar40P", "Pandar64", "PandarQT64", "PandarXT32M".
 std::vector<std::string> hesaiModels();
 
 }  // namespace rigcal::drivers
