@@ -46,6 +46,22 @@ void inflateLz4(std::span<const std::uint8_t> in, std::vector<std::uint8_t>& out
                    std::to_string(out.size()));
 }
 
+// The declared size must be one the compressed bytes can produce: zstd frames usually record their
+// content size, and lz4 cannot expand more than 255:1.
+void checkDeclaredSize(const ChunkRecord& chunk, std::string_view what) {
+  if (chunk.compression == "zstd") {
+    const unsigned long long content = ZSTD_getFrameContentSize(chunk.records.data(), chunk.records.size());
+    if (content == ZSTD_CONTENTSIZE_ERROR)
+      throw BagError(std::string(what) + ": zstd chunk does not decompress: no valid zstd frame header");
+    if (content != ZSTD_CONTENTSIZE_UNKNOWN && content != chunk.uncompressed_size)
+      throw BagError(std::string(what) + ": zstd frame holds " + std::to_string(content) + " bytes, chunk declares " +
+                     std::to_string(chunk.uncompressed_size));
+  } else if (chunk.uncompressed_size > std::uint64_t(chunk.records.size()) * 255 + 64) {
+    throw BagError(std::string(what) + ": lz4 chunk of " + std::to_string(chunk.records.size()) +
+                   " bytes cannot inflate to the declared " + std::to_string(chunk.uncompressed_size));
+  }
+}
+
 }  // namespace
 
 std::span<const std::uint8_t> inflateChunk(const ChunkRecord& chunk, std::vector<std::uint8_t>& buffer,
@@ -59,6 +75,7 @@ std::span<const std::uint8_t> inflateChunk(const ChunkRecord& chunk, std::vector
     if (chunk.uncompressed_size > kMaxChunkBytes)
       throw BagError(std::string(what) + ": chunk declares " + std::to_string(chunk.uncompressed_size) +
                      " uncompressed bytes, more than the " + std::to_string(kMaxChunkBytes) + " accepted");
+    checkDeclaredSize(chunk, what);  // before allocating what a corrupt header claims
     buffer.resize(std::size_t(chunk.uncompressed_size));
     if (chunk.compression == "zstd")
       inflateZstd(chunk.records, buffer, what);
