@@ -238,6 +238,7 @@ void McapFile::load(const Ref& ref, std::size_t order) {
   if (chunk->entries.empty()) return;
   heap_.push({chunk->entries.front().log_time, order, chunk.get()});
   loaded_.push_back(std::move(chunk));
+  peak_loaded_ = std::max(peak_loaded_, loaded_.size());
 }
 
 std::optional<StoredMessage> McapFile::next() {

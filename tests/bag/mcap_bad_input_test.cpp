@@ -115,6 +115,29 @@ TEST(McapReader, OverlappingChunksComeOutInLogTimeOrderWithOrWithoutSummary) {
   EXPECT_TRUE(linear.warnings.empty()) << linear.warnings.front();
 }
 
+// Streaming: a long bag of time-ordered chunks holds one or two chunks at a time, whatever its length;
+// overlapping chunks are held together only while they overlap.
+TEST(McapReader, MemoryHoldsOnlyTheChunksOverlappingTheCurrentMessage) {
+  rigcal::test::TempDir dir;
+  McapTestWriter sequential;
+  for (std::uint64_t c = 0; c < 200; ++c) sequential.addChunk({msg(1, c * 10), msg(2, c * 10 + 5)}, c % 2 ? "zstd" : "lz4");
+  McapTestWriter::save(dir / "long.mcap", sequential.bytes(true));
+  McapFile file(dir / "long.mcap");
+  std::size_t n = 0;
+  while (file.next()) ++n;
+  EXPECT_EQ(n, 400u);
+  EXPECT_EQ(file.chunkCount(), 200u);
+  EXPECT_LE(file.peakLoadedChunks(), 2u);
+
+  McapFile overlapping_file = [&] {
+    McapTestWriter::save(dir / "overlap.mcap", overlappingChunks().bytes(true));
+    return McapFile(dir / "overlap.mcap");
+  }();
+  while (overlapping_file.next()) {
+  }
+  EXPECT_EQ(overlapping_file.peakLoadedChunks(), 3u) << "all three chunks overlap in time";
+}
+
 TEST(McapReader, TruncatedFileDeliversTheChunksBeforeTheCutWithAWarning) {
   rigcal::test::TempDir dir;
   McapTestWriter w;

@@ -32,6 +32,8 @@ class McapFile final : public StorageReader {
   [[nodiscard]] bool indexed() const { return indexed_; }
   /// Chunks (or unchunked messages) found.
   [[nodiscard]] std::size_t chunkCount() const { return refs_.size(); }
+  /// Most chunks held in memory at once so far: the streaming bound (1-2 unless chunk times overlap).
+  [[nodiscard]] std::size_t peakLoadedChunks() const { return peak_loaded_; }
 
  private:
   // A chunk, or a lone message record outside any chunk, with the time range of what it holds.
@@ -79,7 +81,8 @@ class McapFile final : public StorageReader {
   std::string warning_;
   std::vector<std::unique_ptr<Loaded>> loaded_;
   std::priority_queue<HeapItem, std::vector<HeapItem>, std::greater<>> heap_;
-  Loaded* retired_ = nullptr;  // exhausted chunk whose bytes the last message still points into
+  Loaded* retired_ = nullptr;
+  std::size_t peak_loaded_ = 0;  // exhausted chunk whose bytes the last message still points into
 };
 
 }  // namespace rigcal::bag
