@@ -144,7 +144,10 @@ void McapFile::indexRecords(std::span<const std::uint8_t> records, const std::st
 void McapFile::scanLinearly() {
   const std::uint64_t size = file_.size();
   std::uint64_t pos = 8;
+  // Writers compute the data-section CRC from the file's first byte (magic and header included); a
+  // reading of the spec that starts after the Header record is accepted too rather than refuse a good file.
   std::uint32_t data_crc = crc32Update(0, mcap::kMagic);
+  std::uint32_t data_crc_after_header = 0;
   bool in_data = true, footer_seen = false;
   std::vector<std::uint8_t> body, inflated;
   std::vector<Entry> entries;
@@ -174,12 +177,14 @@ void McapFile::scanLinearly() {
     const std::string what = where(pos);
     if (h.opcode == op(Opcode::kDataEnd)) {
       const std::uint32_t stored = mcap::parseDataEnd(body, what);
-      if (in_data && stored != 0 && stored != data_crc)
+      if (in_data && stored != 0 && stored != data_crc && stored != data_crc_after_header)
         throw BagError(what + ": data section CRC mismatch (stored " + std::to_string(stored) + ", computed " +
                        std::to_string(data_crc) + ")");
       in_data = false;
     } else if (in_data) {
       data_crc = crc32Update(crc32Update(data_crc, head), body);
+      if (h.opcode != op(Opcode::kHeader))
+        data_crc_after_header = crc32Update(crc32Update(data_crc_after_header, head), body);
     }
     if (h.opcode == op(Opcode::kSchema)) {
       addSchema(mcap::parseSchema(body, what));

@@ -183,6 +183,32 @@ TEST(McapReader, BadChunkCrcNamesFileAndChunkOffset) {
   EXPECT_NE(e.find("chunk CRC mismatch"), std::string::npos) << e;
 }
 
+// Without a summary the file is walked record by record and the Data End's CRC of the data section is
+// checked: a flipped bit outside any chunk's own CRC (a chunk's start-time field) is caught there.
+TEST(McapReader, BadDataSectionCrcNamesFileAndDataEndOffset) {
+  rigcal::test::TempDir dir;
+  McapTestWriter w;
+  w.addChunk({msg(1, 1), msg(2, 2)}, "");
+  w.addChunk({msg(1, 3)}, "zstd");
+  Bytes bytes = w.bytes(false);
+  McapTestWriter::save(dir / "good.mcap", bytes);
+  EXPECT_EQ(readAll(dir / "good.mcap").messages.size(), 3u) << "the writer's data CRC is accepted";
+  const auto chunks = chunkOffsets(bytes);
+  ASSERT_EQ(chunks.size(), 2u);
+  bytes[chunks[1] + 9] ^= 0x01;  // the second chunk's message_start_time
+  std::size_t data_end = 0;
+  for (std::size_t p = 8; p + 9 <= bytes.size();) {
+    std::uint64_t length;
+    std::memcpy(&length, bytes.data() + p + 1, 8);
+    if (bytes[p] == 0x0F) data_end = p;
+    p += 9 + std::size_t(length);
+  }
+  McapTestWriter::save(dir / "bad_data.mcap", bytes);
+  const std::string e = errorOf(dir / "bad_data.mcap");
+  EXPECT_NE(e.find("bad_data.mcap: record at offset " + std::to_string(data_end)), std::string::npos) << e;
+  EXPECT_NE(e.find("data section CRC mismatch"), std::string::npos) << e;
+}
+
 TEST(McapReader, BadSummaryCrcNamesFileAndFooterOffset) {
   RIGCAL_REQUIRE_DATA(cdr, "bags/rosbag2/mcap_cdr_test/cdr_test_0.mcap");
   rigcal::test::TempDir dir;
