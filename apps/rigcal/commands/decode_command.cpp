@@ -1,4 +1,5 @@
 // `rigcal decode FILE --sensor MODEL ... --out DIR`: decodes a capture into one file per scan.
+// `rigcal decode --bag PATH [--topic T] --sensor MODEL ...` reads the packets from a ROS 2 bag instead.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -8,6 +9,7 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "rigcal/bag/bag_packet_source.hpp"
 #include "rigcal/core/pcd_io.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
@@ -19,7 +21,7 @@ namespace rigcal::app {
 namespace {
 
 struct DecodeOptions {
-  std::string file, model, calibration, metadata, out, format = "pcd", address, time_source = "sensor";
+  std::string file, bag, topic, model, calibration, metadata, out, format = "pcd", address, time_source = "sensor";
   int port = 0;
   double cut_angle = 0.0;
   double min_range = 0.3, max_range = 300.0;
@@ -44,13 +46,23 @@ void run(const DecodeOptions& o) {
   config.max_range_m = float(o.max_range);
 
   std::unique_ptr<drivers::PacketDecoder> decoder;
-  std::unique_ptr<drivers::PcapSource> source;
+  std::unique_ptr<drivers::PacketSource> source;
+  if (o.file.empty() == o.bag.empty())
+    throw CommandFailed(kExitUsage, "decode: give either a capture FILE or --bag PATH");
+  if (!o.bag.empty() && (o.port || !o.address.empty()))
+    throw CommandFailed(kExitUsage, "decode: --port/--address filter pcap datagrams; with --bag choose --topic");
   try {
     decoder = drivers::makeDecoder(config);
-    drivers::PacketFilter filter;
-    if (o.port) filter.destination_port = std::uint16_t(o.port);
-    if (!o.address.empty()) filter.source_address = drivers::parseIpv4(o.address);
-    source = std::make_unique<drivers::PcapSource>(o.file, filter);
+    if (!o.bag.empty()) {
+      auto bag = std::make_unique<bag::BagPacketSource>(o.bag, o.topic);
+      std::cout << "bag topic " << bag->topic() << " (" << bag->type() << ")\n";
+      source = std::move(bag);
+    } else {
+      drivers::PacketFilter filter;
+      if (o.port) filter.destination_port = std::uint16_t(o.port);
+      if (!o.address.empty()) filter.source_address = drivers::parseIpv4(o.address);
+      source = std::make_unique<drivers::PcapSource>(o.file, filter);
+    }
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());
   }
@@ -81,7 +93,8 @@ void run(const DecodeOptions& o) {
             << " other datagrams filtered out)\n";
   if (a.malformed) std::cerr << "warning: last malformed packet: " << a.last_error << '\n';
   if (!source->warning().empty()) std::cerr << "warning: " << source->warning() << '\n';
-  if (written == 0) throw CommandFailed(kExitNotEnoughData, o.file + ": no " + o.model + " scans decoded");
+  if (written == 0)
+    throw CommandFailed(kExitNotEnoughData, (o.bag.empty() ? o.file : o.bag) + ": no " + o.model + " scans decoded");
 }
 
 }  // namespace
@@ -89,7 +102,10 @@ void run(const DecodeOptions& o) {
 void addDecodeCommand(CLI::App& app) {
   auto o = std::make_shared<DecodeOptions>();
   auto* cmd = app.add_subcommand("decode", "Decode a capture of one lidar into one file per scan");
-  cmd->add_option("file", o->file, "pcap or pcapng capture")->required()->check(CLI::ExistingFile);
+  cmd->add_option("file", o->file, "pcap or pcapng capture")->check(CLI::ExistingFile);
+  cmd->add_option("--bag", o->bag, "ROS 2 bag (rosbag2 folder, .mcap or .db3) with packet-scan messages")
+      ->check(CLI::ExistingPath);
+  cmd->add_option("--topic", o->topic, "The bag's packet topic (needed when it holds several)");
   cmd->add_option("--sensor", o->model, "Lidar model, e.g. VLP-16, OS1-64, PandarXT32")->required();
   cmd->add_option("--calibration", o->calibration, "Velodyne YAML/XML or Hesai angle CSV")
       ->check(CLI::ExistingFile);
