@@ -24,5 +24,6 @@ void addMapCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addCalibratePoseCommand(CLI::App& app);
 void addCalibrateCommand(CLI::App& app);
+void addRegisterCommand(CLI::App& app);
 
 }  // namespace rigcal::app

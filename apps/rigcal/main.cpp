@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   addCompareCommand(app);
   addCalibratePoseCommand(app);
   addCalibrateCommand(app);
+  addRegisterCommand(app);
 
   try {
     app.parse(argc, argv);
