@@ -244,7 +244,7 @@ void writeRegistrationYaml(const std::filesystem::path& path, const CloudPairRes
       << "\n  deadline_reached: " << (r.ensemble.deadline_reached ? "true" : "false") << "\n  seconds: " << r.ensemble.seconds
       << "\n";
   out << "overlap:\n  source_share: " << r.source_overlap << "\n  target_share: " << r.target_overlap << "\n"
-      << "information:  # Hessian eigenvalue shares per direction (target frame); weak < 0.01\n"
+      << "information:  # Hessian eigenvalue shares per direction (target frame); weak < " << kWeakShare << "\n"
       << "  correspondences: " << r.information.correspondences << "\n";
   for (const auto* block : {&r.information.translation, &r.information.rotation}) {
     out << (block == &r.information.translation ? "  translation:\n" : "  rotation:\n");

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <algorithm>
 #include <map>
+#include <set>
 #include <random>
 
 #include <yaml-cpp/yaml.h>
@@ -128,6 +130,33 @@ TEST_F(RegisterCommand, HalvesOfARealScanWithAKnownOffsetFromFarStarts) {
   }
 }
 
+TEST_F(RegisterCommand, GroundOnlyPairIsReportedAsPoorlyConstrained) {
+  // The real scan's ground alone (flat: x, y and yaw are free) as the two halves, the start as a 4x4 matrix.
+  Scan scan = loadScan(3);
+  std::vector<float> z(scan.z);
+  std::nth_element(z.begin(), z.begin() + std::ptrdiff_t(z.size() / 10), z.end());
+  const float ground = z[z.size() / 10];
+  scan.filter([&](std::size_t i) { return std::abs(scan.z[i] - ground) < 0.15F && std::hypot(scan.x[i], scan.y[i]) < 15.0F; });
+  const Pose truth = fromXyzRpy({0.05, 0.0, 0.02, 0.0, 0.0, 0.0});
+  writePcd(dir / "t.pcd", toTable(every(scan, 2, 0)));
+  writePcd(dir / "s.pcd", toTable(every(scan, 2, 1, truth.inverse())));
+  std::ofstream(dir / "start.txt") << "# T_target_source\n[1, 0, 0, 0]\n[0, 1, 0, 0]\n[0, 0, 1, 0]\n[0, 0, 0, 1]\n";
+  const auto r = test::runRigcal({"register", "--target", (dir / "t.pcd").string(), "--source", (dir / "s.pcd").string(),
+                                  "--initial-matrix", (dir / "start.txt").string(), "--local", "--out",
+                                  (dir / "out").string()});
+  std::cout << r.out << r.err;
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 1) << r.err;
+  const YAML::Node weak = YAML::LoadFile((dir / "out/registration.yaml").string())["weak_directions"];
+  std::set<std::string> names;
+  for (const auto& w : weak) names.insert(w.as<std::string>());
+  EXPECT_TRUE(names.count("yaw")) << r.out << r.err;
+  EXPECT_TRUE(names.count("x") || names.count("y")) << r.out << r.err;
+  EXPECT_FALSE(names.count("z")) << "the ground fixes the height: " << r.out;
+  if (r.exit_code == 0) {
+    EXPECT_NE(r.err.find("warning: poorly constrained"), std::string::npos) << r.err;
+  }
+}
+
 TEST_F(RegisterCommand, TwoRealScansAgreeFromPerturbedStarts) {
   writePcd(dir / "t.pcd", toTable(loadScan(2)));
   writePcd(dir / "s.pcd", toTable(loadScan(4)));
@@ -191,6 +220,10 @@ TEST_F(RegisterCommand, BadInputGivesOneLineErrorsAndExitCodes) {
   expectOneLineError(reg("empty.pcd", "good.pcd"), 4, "empty.pcd: empty cloud");
   expectOneLineError(reg("good.pcd", "corrupt.pcd"), 4, "corrupt.pcd: binary_compressed: corrupt LZF data");
   expectOneLineError(reg("ahead.pcd", "behind.pcd"), 5, "the clouds do not overlap");
+  std::ofstream(dir / "m.txt") << "1 0 0\n0 1 0\n";
+  const auto matrix = test::runRigcal({"register", "--target", (dir / "good.pcd").string(), "--source",
+                                       (dir / "good.pcd").string(), "--initial-matrix", (dir / "m.txt").string()});
+  expectOneLineError(matrix, 4, "m.txt: 6 numbers, a 4x4 matrix needs 16");
   const auto usage = test::runRigcal({"register", "--target", (dir / "good.pcd").string(), "--source",
                                       (dir / "good.pcd").string(), "--initial", "1", "2"});
   EXPECT_EQ(usage.exit_code, 2) << usage.err;

@@ -20,6 +20,10 @@
 
 namespace rigcal::calib {
 
+/// Measured on a real HDL-32E street scan: its weakest directions hold 0.04-0.08 of the information; the same
+/// scan's ground alone 0.011-0.026 along x / y and 0.002 about yaw.
+inline constexpr double kWeakShare = 0.03;
+
 struct DirectionInformation {
   std::string name;             // the nearest axis: x, y, z (translation) or roll, pitch, yaw (rotation)
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // unit, target frame
@@ -39,6 +43,6 @@ struct RegistrationInformation {
 /// `target` must have normals. Correspondences: nearest target point within max_distance.
 RegistrationInformation registrationInformation(const registration::Target& target,
                                                 const registration::PointCloud& source, const Pose& T_target_source,
-                                                double max_distance, double weak_share = 0.01);
+                                                double max_distance, double weak_share = kWeakShare);
 
 }  // namespace rigcal::calib
