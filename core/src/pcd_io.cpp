@@ -112,6 +112,18 @@ void readCompressedColumns(std::istream& in, PointTable& table, std::size_t poin
                        std::to_string(points) + " points of " + std::to_string(row) + " bytes need " +
                        std::to_string(points * row));
   if (points == 0) return;
+  // Both sizes are bounded before anything is allocated: the compressed bytes by what the file holds, the
+  // uncompressed by LZF's largest expansion (a 3-byte back-reference yields at most 264 bytes).
+  const auto here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const auto left = std::uint64_t(in.tellg() - here);
+  in.seekg(here);
+  if (compressed > left)
+    failFile(path, "binary_compressed data truncated: " + std::to_string(left) + " of " + std::to_string(compressed) +
+                       " compressed bytes");
+  if (uncompressed > 100ULL * compressed + 64)
+    failFile(path, "binary_compressed: " + std::to_string(compressed) + " compressed bytes cannot expand to " +
+                       std::to_string(uncompressed));
   std::vector<std::uint8_t> packed(compressed);
   if (!in.read(reinterpret_cast<char*>(packed.data()), std::streamsize(compressed)))
     failFile(path, "binary_compressed data truncated: " + std::to_string(in.gcount()) + " of " +

@@ -113,7 +113,9 @@ TEST_F(PointCloudIo, CorruptCompressedAndGarbageFilesAreRefusedClearly) {
   EXPECT_NE(errorOf(dir / "size.pcd").find("3 points of 4 bytes need 12"), std::string::npos) << errorOf(dir / "size.pcd");
   writeCompressedPcd(dir / "short.pcd", 2, 8, {3, 0, 0, 0x80});  // literal run past the end
   EXPECT_NE(errorOf(dir / "short.pcd").find("past the end"), std::string::npos) << errorOf(dir / "short.pcd");
-  for (const char* name : {"far.pcd", "size.pcd", "short.pcd"})
+  writeCompressedPcd(dir / "huge.pcd", 1000000, 4000000, good);  // 7 bytes cannot hold 4 MB: refused before allocating
+  EXPECT_NE(errorOf(dir / "huge.pcd").find("cannot expand to 4000000"), std::string::npos) << errorOf(dir / "huge.pcd");
+  for (const char* name : {"far.pcd", "size.pcd", "short.pcd", "huge.pcd"})
     EXPECT_EQ(errorOf(dir / name).find('\n'), std::string::npos) << "one line: " << errorOf(dir / name);
 
   std::ofstream(dir / "g.ply") << "this is not a ply\n";
