@@ -25,5 +25,6 @@ void addCompareCommand(CLI::App& app);
 void addCalibratePoseCommand(CLI::App& app);
 void addCalibrateCommand(CLI::App& app);
 void addInspectCommand(CLI::App& app);
+void addRegisterCommand(CLI::App& app);
 
 }  // namespace rigcal::app

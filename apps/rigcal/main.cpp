@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   addCalibratePoseCommand(app);
   addCalibrateCommand(app);
   addInspectCommand(app);
+  addRegisterCommand(app);
 
   try {
     app.parse(argc, argv);

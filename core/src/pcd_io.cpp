@@ -1,9 +1,13 @@
 #include "rigcal/core/pcd_io.hpp"
 
+#include <cstdint>
+#include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include "rigcal/core/lzf.hpp"
 #include "table_rows.hpp"
 
 namespace rigcal {
@@ -80,8 +84,69 @@ Header readHeader(std::istream& in, const std::filesystem::path& path) {
   if (h.sizes.size() != h.names.size() || h.types.size() != h.names.size() ||
       h.counts.size() != h.names.size())
     failFile(path, "PCD header FIELDS, SIZE, TYPE and COUNT have different lengths");
+  for (const int c : h.counts)
+    if (c < 1 || c > 65536) failFile(path, "PCD header COUNT " + std::to_string(c) + " out of range 1..65536");
   if (!have_points) h.points = width * height;
   return h;
+}
+
+std::uint32_t readU32(std::istream& in, const char* what, const std::filesystem::path& path) {
+  unsigned char b[4];
+  if (!in.read(reinterpret_cast<char*>(b), 4))
+    failFile(path, std::string("binary_compressed data truncated before its ") + what);
+  return std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24;
+}
+
+// PCL's binary_compressed body: u32 compressed size, u32 uncompressed size, then LZF data that expands to
+// the fields one after another (all points' x, then all points' y, ...), not row by row.
+void readCompressedColumns(std::istream& in, PointTable& table, std::size_t points, const std::vector<int>& counts,
+                           const std::filesystem::path& path) {
+  const std::uint32_t compressed = readU32(in, "compressed size", path);
+  const std::uint32_t uncompressed = readU32(in, "uncompressed size", path);
+  std::size_t row = 0;
+  for (const auto& f : table.fields()) row += fieldSize(f.type);
+  if (row != 0 && points > std::numeric_limits<std::uint32_t>::max() / row)
+    failFile(path, "binary_compressed: " + std::to_string(points) + " points cannot fit in one file");
+  if (uncompressed != points * row)
+    failFile(path, "binary_compressed: uncompressed size " + std::to_string(uncompressed) + " bytes, but " +
+                       std::to_string(points) + " points of " + std::to_string(row) + " bytes need " +
+                       std::to_string(points * row));
+  if (points == 0) return;
+  // Both sizes are bounded before anything is allocated: the compressed bytes by what the file holds, the
+  // uncompressed by LZF's largest expansion (a 3-byte back-reference yields at most 264 bytes).
+  const auto here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const auto left = std::uint64_t(in.tellg() - here);
+  in.seekg(here);
+  if (compressed > left)
+    failFile(path, "binary_compressed data truncated: " + std::to_string(left) + " of " + std::to_string(compressed) +
+                       " compressed bytes");
+  if (uncompressed > 100ULL * compressed + 64)
+    failFile(path, "binary_compressed: " + std::to_string(compressed) + " compressed bytes cannot expand to " +
+                       std::to_string(uncompressed));
+  std::vector<std::uint8_t> packed(compressed);
+  if (!in.read(reinterpret_cast<char*>(packed.data()), std::streamsize(compressed)))
+    failFile(path, "binary_compressed data truncated: " + std::to_string(in.gcount()) + " of " +
+                       std::to_string(compressed) + " compressed bytes");
+  std::vector<std::uint8_t> bytes;
+  try {
+    bytes = lzfDecompress(packed, uncompressed);
+  } catch (const std::runtime_error& e) {
+    failFile(path, std::string("binary_compressed: ") + e.what());
+  }
+  // A field of COUNT n was expanded into n consecutive columns; in the file it is one block of
+  // points * n values, point-major.
+  const std::uint8_t* p = bytes.data();
+  auto& columns = table.fields();
+  std::size_t column = 0;
+  for (std::size_t f = 0; f < counts.size(); ++f) {
+    const auto n = std::size_t(counts[f]);
+    const FieldType type = columns[column].type;
+    for (std::size_t i = 0; i < points; ++i)
+      for (std::size_t k = 0; k < n; ++k, p += fieldSize(type))
+        columns[column + k].values.push_back(detail::readValue(p, type));
+    column += n;
+  }
 }
 
 }  // namespace
@@ -103,8 +168,10 @@ PointTable readPcd(const std::filesystem::path& path) {
     detail::readAsciiRows(in, table, h.points, "point", path);
   else if (h.data == "binary")
     detail::readBinaryRows(in, table, h.points, "point", path);
+  else if (h.data == "binary_compressed")
+    readCompressedColumns(in, table, h.points, h.counts, path);
   else
-    failFile(path, "unsupported PCD DATA encoding '" + h.data + "' (ascii and binary are read)");
+    failFile(path, "unsupported PCD DATA encoding '" + h.data + "' (ascii, binary and binary_compressed are read)");
   return table;
 }
 

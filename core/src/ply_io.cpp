@@ -66,8 +66,10 @@ PointTable readPly(const std::filesystem::path& path) {
       std::string name;
       std::size_t count = 0;
       ls >> name >> count;
-      if (seen_vertex && name != "vertex") failFile(path, "only a single 'vertex' element is read");
+      // Elements after the vertices (a mesh's faces) are ignored: their data follows the vertex block.
+      if (seen_vertex && name == "vertex") failFile(path, "more than one 'vertex' element");
       in_vertex = name == "vertex";
+      if (seen_vertex && !in_vertex) continue;
       if (in_vertex) {
         vertices = count;
         seen_vertex = true;
@@ -77,7 +79,8 @@ PointTable readPly(const std::filesystem::path& path) {
     } else if (key == "property") {
       std::string type, name;
       ls >> type >> name;
-      if (type == "list") failFile(path, "list properties are not supported");
+      if (!in_vertex) continue;  // a property of an ignored element
+      if (type == "list") failFile(path, "list properties are not supported in the vertex element");
       if (in_vertex) table.add(name, plyType(type, path)).values.reserve(vertices);
     } else if (key == "end_header") {
       break;

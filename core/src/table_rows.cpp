@@ -1,6 +1,8 @@
 #include "table_rows.hpp"
 
+#include <cstdlib>
 #include <cstring>
+#include <string>
 #include <iomanip>
 #include <istream>
 #include <limits>
@@ -11,7 +13,7 @@ namespace rigcal::detail {
 namespace {
 
 template <class T>
-double load(const char* p) {
+double load(const void* p) {
   T v;
   std::memcpy(&v, p, sizeof v);
   return static_cast<double>(v);
@@ -23,7 +25,9 @@ void store(char* p, double value) {
   std::memcpy(p, &v, sizeof v);
 }
 
-double readValue(const char* p, FieldType t) {
+}  // namespace
+
+double readValue(const void* p, FieldType t) {
   switch (t) {
     case FieldType::kI8: return load<std::int8_t>(p);
     case FieldType::kU8: return load<std::uint8_t>(p);
@@ -38,6 +42,8 @@ double readValue(const char* p, FieldType t) {
   }
   return 0.0;
 }
+
+namespace {
 
 void writeValue(char* p, FieldType t, double v) {
   switch (t) {
@@ -72,10 +78,16 @@ void readAsciiRows(std::istream& in, PointTable& table, std::size_t rows, const 
                    const std::filesystem::path& path) {
   for (std::size_t i = 0; i < rows; ++i)
     for (auto& f : table.fields()) {
-      double v;
-      if (!(in >> v))
+      // Token then strtod: PCL writes invalid points as "nan", which operator>> does not parse.
+      std::string token;
+      if (!(in >> token))
         failFile(path, "truncated ascii data at " + std::string(unit) + " " + std::to_string(i) +
                            " of " + std::to_string(rows));
+      char* end = nullptr;
+      const double v = std::strtod(token.c_str(), &end);
+      if (end == token.c_str() || *end != '\0')
+        failFile(path, "'" + token + "' is not a number at " + std::string(unit) + " " + std::to_string(i) +
+                           " field " + f.name);
       f.values.push_back(v);
     }
 }

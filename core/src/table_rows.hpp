@@ -16,6 +16,9 @@ void readBinaryRows(std::istream& in, PointTable& table, std::size_t rows, const
 void writeAsciiRows(std::ostream& out, const PointTable& table);
 void writeBinaryRows(std::ostream& out, const PointTable& table);
 
+/// One little-endian value of type t at p, widened to double.
+double readValue(const void* p, FieldType t);
+
 [[noreturn]] void failFile(const std::filesystem::path& path, const std::string& what);
 
 }  // namespace rigcal::detail

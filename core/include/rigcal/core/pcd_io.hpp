@@ -1,6 +1,7 @@
 #pragma once
-// PCD v0.7 files (the format PCL and most lidar tools read), ascii and binary, unorganised or organised.
-// binary_compressed is refused with a clear error: nothing we exchange uses it.
+// PCD v0.7 files (the format PCL and most lidar tools read), unorganised or organised. Read: ascii, binary
+// and PCL's binary_compressed (LZF, see lzf.hpp), any field order, COUNT > 1 expanded to name_0, name_1, ...
+// Written: ascii and binary.
 #include <filesystem>
 
 #include "rigcal/core/point_table.hpp"

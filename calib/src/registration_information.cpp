@@ -1,0 +1,62 @@
+#include "rigcal/calib/registration_information.hpp"
+
+#include <Eigen/Eigenvalues>
+
+namespace rigcal::calib {
+namespace {
+
+std::array<DirectionInformation, 3> decompose(const Eigen::Matrix3d& H, double normaliser, double weak_share,
+                                              const std::array<const char*, 3>& names) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(H);
+  std::array<DirectionInformation, 3> out;
+  for (int k = 0; k < 3; ++k) {
+    auto& d = out[std::size_t(k)];
+    d.direction = es.eigenvectors().col(k).normalized();
+    Eigen::Index axis = 0;
+    d.direction.cwiseAbs().maxCoeff(&axis);
+    if (d.direction[axis] < 0) d.direction = -d.direction;
+    d.name = names[std::size_t(axis)];
+    d.eigenvalue = std::max(0.0, es.eigenvalues()[k]);
+    d.share = normaliser > 0 ? d.eigenvalue / normaliser : 0.0;
+    d.weak = d.share < weak_share;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> RegistrationInformation::weakDirections() const {
+  std::vector<std::string> names;
+  for (const auto* block : {&translation, &rotation})
+    for (const auto& d : *block)
+      if (d.weak) names.push_back(d.name);
+  return names;
+}
+
+RegistrationInformation registrationInformation(const registration::Target& target,
+                                                const registration::PointCloud& source, const Pose& T,
+                                                double max_distance, double weak_share) {
+  RegistrationInformation info;
+  Eigen::Matrix3d Htt = Eigen::Matrix3d::Zero(), Hrr = Eigen::Matrix3d::Zero();
+  double lever_sq = 0.0;
+  const Eigen::Vector3d t = T.translation();
+  const auto& tn = target.cloud().normals;
+  for (const auto& p : source.points) {
+    const Eigen::Vector4d q = (T * p.head<3>()).homogeneous();
+    registration::Neighbor nb;
+    if (!target.tree().nearest(q, max_distance * max_distance, &nb)) continue;
+    const Eigen::Vector3d n = tn[nb.index].head<3>();
+    if (n.squaredNorm() < 0.5) continue;  // no normal estimated there
+    const Eigen::Vector3d arm = q.head<3>() - t;
+    const Eigen::Vector3d jr = arm.cross(n);
+    Htt += n * n.transpose();
+    Hrr += jr * jr.transpose();
+    lever_sq += arm.squaredNorm();
+    ++info.correspondences;
+  }
+  info.translation = decompose(Htt, double(info.correspondences), weak_share, {"x", "y", "z"});
+  info.rotation = decompose(Hrr, lever_sq, weak_share, {"roll", "pitch", "yaw"});
+  return info;
+}
+
+}  // namespace rigcal::calib
