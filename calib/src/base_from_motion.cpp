@@ -149,13 +149,17 @@ Fit robustFit(const std::vector<const Chord*>& chords, double yaw0, double x0, b
     w.swap(next);
     if (settled) break;
   }
-  // Standard deviation from the data: the weighted residual variance propagated through (JᵀWJ)⁻¹.
+  // Standard deviation from the data: the weighted residual variance propagated through (JᵀWJ)⁻¹, with
+  // the final weights.
   double wrr = 0.0, sum_r2 = 0.0;
+  H.setZero();
   for (std::size_t k = 0; k < n; ++k) {
     if (w[k] == 0) {
       ++f.outliers;
       continue;
     }
+    const Eigen::Vector2d J(chords[k]->a * std::cos(f.yaw) - chords[k]->b * std::sin(f.yaw), -chords[k]->c);
+    H += w[k] * J * J.transpose();
     ++f.used;
     wrr += w[k] * r[k] * r[k];
     sum_r2 += r[k] * r[k];
