@@ -46,11 +46,12 @@ std::vector<Chord> chordsOf(const std::vector<TimeNs>& stamps, const std::vector
       ++i;
       continue;
     }
-    // Walk forward until chord_m of travel, never across a lost frame.
+    // Walk forward until chord_m of travel, never across a lost frame, nor longer than max_chord_s (a
+    // long stop then costs O(frames in max_chord_s) per frame, not O(frames of the stop)).
     double path = 0.0;
     std::size_t j = i;
     bool broken = false;
-    while (j + 1 < n && path < s.chord_m) {
+    while (j + 1 < n && path < s.chord_m && toSeconds(stamps[j + 1] - stamps[i]) <= s.max_chord_s) {
       if (!ok(j + 1)) {
         broken = true;
         break;
@@ -62,9 +63,9 @@ std::vector<Chord> chordsOf(const std::vector<TimeNs>& stamps, const std::vector
       i = j + 1;
       continue;
     }
-    if (path < s.chord_m) break;  // the end of the drive
+    if (path < s.chord_m && j + 1 >= n) break;  // the end of the drive
     const double dt = toSeconds(stamps[j] - stamps[i]);
-    if (dt <= 0 || dt > s.max_chord_s || path / dt < s.min_speed_mps) {
+    if (path < s.chord_m || dt <= 0 || path / dt < s.min_speed_mps) {
       ++i;  // a stop or slow creep at the start: try from the next frame
       continue;
     }

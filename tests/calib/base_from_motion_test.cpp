@@ -228,3 +228,20 @@ TEST(BaseFromMotion, SideSlipAndNoiseLimits) {
 
 }  // namespace
 }  // namespace rigcal::calib
+
+namespace rigcal::calib {
+namespace {
+
+TEST(BaseFromMotion, LongStopStaysCheap) {
+  // Ten minutes parked (mapper jitter only) between two drives: skipped quickly, the drives still count.
+  const auto r = [] {
+    const auto d = drive({{6, 3.0, 0}, {600, 0, 0}, {6, 3.0, 0}}, {0.001, 0.01, 0.0, 9});
+    return estimate(d, BaseFromMotionMode::kYaw);
+  }();
+  ASSERT_TRUE(r.yaw.estimated) << r.yaw.note;
+  EXPECT_LT(std::abs(rad2deg(r.yaw.value - kTruth.yaw)), 0.1);
+  EXPECT_LT(r.moving_m, 40.0);
+}
+
+}  // namespace
+}  // namespace rigcal::calib

@@ -14,6 +14,7 @@
 // of the equation; stops and slow creeping are skipped by the speed threshold; a chord spanning a
 // direction change (cusp) or a lost frame is dropped.
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
