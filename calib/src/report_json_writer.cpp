@@ -134,6 +134,30 @@ json reportJson(const CalibrationOutcome& o) {
                   {"d", o.base->plane.d},
                   {"inliers", o.base->plane.inliers},
                   {"inlier_percentage", o.base->plane.inlier_percentage}};
+    // Where each component of the result came from, and the motion estimate's support and spread.
+    const auto& m = o.base_motion;
+    const auto from = [&](const MotionComponent* c) { return c != nullptr && c->estimated ? "motion" : "guess"; };
+    b["sources"] = {{"x", from(m ? &m->x : nullptr)}, {"y", "guess"}, {"z", "ground"}, {"roll", "ground"},
+                    {"pitch", "ground"}, {"yaw", from(m ? &m->yaw : nullptr)}};
+    if (m) {
+      const auto component = [](const MotionComponent& c, double scale) {
+        json e = {{"estimated", c.estimated}, {"value", c.value * scale}, {"stddev", c.stddev * scale}};
+        if (!c.estimated) e["note"] = c.note;
+        return e;
+      };
+      b["motion"] = {{"yaw_deg", component(m->yaw, rad2deg(1.0))},
+                     {"x_m", component(m->x, 1.0)},
+                     {"y", "not observable from motion; kept the guess"},
+                     {"moving_m", m->moving_m},
+                     {"straight_m", m->straight_m},
+                     {"left_turn_deg", m->left_turn_deg},
+                     {"right_turn_deg", m->right_turn_deg},
+                     {"reversing_m", m->reversing_m},
+                     {"chords", m->chords},
+                     {"chords_used", m->chords_used},
+                     {"outliers", m->outliers},
+                     {"residual_rms_m", m->residual_rms_m}};
+    }
     j["base_lidar"] = b;
   }
   const auto it = o.initial_T_base_sensor.find(o.mapping_sensor);

@@ -59,6 +59,12 @@ std::string summaryTable(const CalibrationOutcome& o) {
     }
   }
   if (o.base && !o.base->ok) out << "  " << o.mapping_sensor << " (base): " << o.base->failure << "\n";
+  if (o.base && o.base->ok) {
+    // Which parts of base_link -> mapping lidar came from where.
+    out << "  " << o.base_frame << " -> " << o.mapping_sensor << ": z, roll, pitch from the ground; ";
+    if (o.base_motion) out << describeBaseFromMotion(*o.base_motion) << "\n";
+    else out << "x, y, yaw from the guess (base_link_from_motion: off)\n";
+  }
   out << "  ok (dl) = best result when the deadline (" << o.deadline_s << " s) was reached; dt, dr = change from the initial guess\n";
   return out.str();
 }

@@ -76,6 +76,7 @@ const std::vector<ParameterSpec>& parameterSpecs() {
       {"base_lidar_min_plane_points_percentage", &P::base_lidar_min_plane_points_percentage, 0, 100, {}},
       {"base_lidar_max_cos_distance", &P::base_lidar_max_cos_distance, 0, 1, {}},
       {"base_lidar_overwrite_xy_yaw", &P::base_lidar_overwrite_xy_yaw, 0, 0, {}},
+      {"base_link_from_motion", &P::base_link_from_motion, 0, 0, {"off", "yaw", "yaw_x"}},
   };
   return specs;
 }

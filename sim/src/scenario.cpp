@@ -155,7 +155,7 @@ SensorSpec readSensor(const Reader& r, const YAML::Node& n) {
 }
 
 TrajectorySpec readTrajectory(const Reader& r, const YAML::Node& n) {
-  r.map(n, "trajectory", {"start", "wheelbase_m", "track_m", "excitation", "segments"});
+  r.map(n, "trajectory", {"start", "wheelbase_m", "track_m", "excitation", "segments", "base_link", "side_slip_deg_per_g"});
   TrajectorySpec t;
   if (const YAML::Node s = n["start"]) {
     r.map(s, "trajectory start", {"x", "y", "yaw_deg", "speed_kmh"});
@@ -165,6 +165,12 @@ TrajectorySpec readTrajectory(const Reader& r, const YAML::Node& n) {
   }
   t.wheelbase_m = r.number(n, "wheelbase_m", t.wheelbase_m, 0.5, 10);
   t.track_m = r.number(n, "track_m", t.track_m, 0.5, 5);
+  if (const YAML::Node b = n["base_link"]) {
+    const std::string where = r.text(b, "base_link");
+    if (where != "centre" && where != "rear_axle") r.fail(b, "base_link '" + where + "' is not one of centre, rear_axle");
+    t.base_link_on_rear_axle = where == "rear_axle";
+  }
+  t.side_slip_rad_per_g = deg2rad(r.number(n, "side_slip_deg_per_g", 0, 0, 30));
   if (const YAML::Node e = n["excitation"]) {
     r.map(e, "excitation", {"roll_deg", "pitch_deg", "heave_m", "roll_period_s", "pitch_period_s", "heave_period_s"});
     Excitation& x = t.excitation;

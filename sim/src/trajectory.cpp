@@ -76,12 +76,17 @@ Trajectory::State Trajectory::state(double t_s) const {
   const double local = sp.v0 * tau + dv * sp.duration * smoothstepIntegral(u);
   st.s = sp.s0 + local;
   st.h = sp.h0 + (sp.length > 0 ? sp.turn * turnFraction(local / sp.length) : 0.0);
+  // dh/ds = turn·H'(x)/length, H'(x) = 1 − cos(2πx).
+  st.k = sp.length > 0 ? sp.turn * (1 - std::cos(2 * M_PI * local / sp.length)) / sp.length : 0.0;
   return st;
 }
 
 Eigen::Vector2d Trajectory::velocity(double t_s) const {
   const State st = state(t_s);
-  return st.v * Eigen::Vector2d(std::cos(st.h), std::sin(st.h));
+  // Side slip: the velocity turns off the body's axis toward the outside of the turn, by an angle
+  // proportional to the lateral acceleration v²·κ.
+  const double beta = -spec_.side_slip_rad_per_g * st.v * st.v * st.k / 9.81;
+  return st.v * Eigen::Vector2d(std::cos(st.h + beta), std::sin(st.h + beta));
 }
 
 double Trajectory::speed(double t_s) const { return state(t_s).v; }
@@ -107,14 +112,16 @@ Pose Trajectory::pose(TimeNs t) const {
   const double h = heading(t_s);
   const Eigen::Vector2d f(std::cos(h), std::sin(h)), l(-std::sin(h), std::cos(h));
   // The body rests on its four wheels: height, pitch and roll from the terrain under them.
-  const Eigen::Vector2d front = p + 0.5 * spec_.wheelbase_m * f, rear = p - 0.5 * spec_.wheelbase_m * f;
-  const Eigen::Vector2d left = p + 0.5 * spec_.track_m * l, right = p - 0.5 * spec_.track_m * l;
+  const Eigen::Vector2d centre = spec_.base_link_on_rear_axle ? Eigen::Vector2d(p + 0.5 * spec_.wheelbase_m * f) : p;
+  const Eigen::Vector2d front = centre + 0.5 * spec_.wheelbase_m * f, rear = centre - 0.5 * spec_.wheelbase_m * f;
+  const Eigen::Vector2d left = centre + 0.5 * spec_.track_m * l, right = centre - 0.5 * spec_.track_m * l;
   const double gf = ground_.height(front.x(), front.y()), gr = ground_.height(rear.x(), rear.y());
   const double gl = ground_.height(left.x(), left.y()), gri = ground_.height(right.x(), right.y());
   XyzRpy v;
   v.x = p.x();
   v.y = p.y();
-  v.z = 0.25 * (gf + gr + gl + gri);
+  // The body's height at base_link: the wheels' mean height, or the rear axle's on the rear axle.
+  v.z = spec_.base_link_on_rear_axle ? gr : 0.25 * (gf + gr + gl + gri);
   v.pitch = -std::atan2(gf - gr, spec_.wheelbase_m);  // ROS: positive pitch = nose down
   v.roll = std::atan2(gl - gri, spec_.track_m);       // positive roll = left side up
   v.yaw = h;

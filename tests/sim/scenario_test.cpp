@@ -19,7 +19,7 @@ std::vector<std::string> modelsOf(const Scenario& s) {
 }
 
 TEST(Scenario, PresetsDescribeTheRequestedRigs) {
-  EXPECT_EQ(builtinScenarioNames(), (std::vector<std::string>{"lost", "parking-lot", "pose", "street"}));
+  EXPECT_EQ(builtinScenarioNames(), (std::vector<std::string>{"base-motion", "lost", "parking-lot", "pose", "street"}));
   const Scenario p = loadScenario("parking-lot");
   EXPECT_EQ(modelsOf(p), (std::vector<std::string>{"OS1-64", "VLP-16", "VLP-16"}));
   EXPECT_EQ(p.calibration_lidars.size(), 2u);

@@ -19,6 +19,7 @@
 #include "../exit_codes.hpp"
 #include "../pipeline_options.hpp"
 #include "../stop_signals.hpp"
+#include "rigcal/calib/base_from_motion.hpp"
 #include "rigcal/calib/base_lidar_calibration.hpp"
 #include "rigcal/calib/base_lidar_multi.hpp"
 #include "rigcal/calib/calibration_outcome.hpp"
@@ -133,7 +134,25 @@ void run(const CalibrateOptions& o) {
     points.reserve(s.size());
     for (std::size_t i = 0; i < s.size(); ++i) points.emplace_back(s.x[i], s.y[i], s.z[i]);
     outcome.base = calib::calibrateBaseLidarMulti(points, keyframes, mapping.T_base_mapping, rig.parameters);
+    // Then yaw (and x) from the drive, levelled by the ground's roll and pitch (base_link_from_motion).
+    const auto motion_mode = calib::parseBaseFromMotionMode(rig.parameters.base_link_from_motion);
+    if (outcome.base->ok && motion_mode != calib::BaseFromMotionMode::kOff) {
+      std::vector<TimeNs> stamps;
+      std::vector<Pose> poses;
+      std::vector<bool> usable;
+      for (const auto& f : mapping.trajectory) {
+        if (!stamps.empty() && f.stamp_ns <= stamps.back()) continue;
+        stamps.push_back(f.stamp_ns);
+        poses.push_back(f.T_map_lidar);
+        usable.push_back(!f.lost);
+      }
+      outcome.base_motion =
+          calib::estimateBaseFromMotion(stamps, poses, usable, outcome.base->T_base_lidar, motion_mode);
+      outcome.base->T_base_lidar = outcome.base_motion->T_base_lidar;
+    }
   }
+  if (!rig.parameters.calibrate_base_frame && rig.parameters.base_link_from_motion != "off")
+    std::cerr << "base_link_from_motion needs calibrate_base_frame: true (roll and pitch from the ground); ignored\n";
   const double base_seconds = since(t_base);
 
   const auto progress_now = pipe->progress();

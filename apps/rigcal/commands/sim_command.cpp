@@ -141,7 +141,7 @@ void run(const SimArgs& a) {
 void addSimCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("sim", "Simulate a rig recording with ground truth (truth.yaml, poses.csv, rig.yaml)");
   auto a = std::make_shared<SimArgs>();
-  cmd->add_option("--scenario", a->scenario, "Preset name (parking-lot, street, lost, pose) or a scenario YAML file")
+  cmd->add_option("--scenario", a->scenario, "Preset name (parking-lot, street, lost, pose, base-motion) or a scenario YAML file")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "Output folder (created if missing)");
   cmd->add_option("--seed", a->seed, "Seed (default: the scenario's)");

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "rigcal/calib/base_from_motion.hpp"
 #include "rigcal/calib/base_lidar_calibration.hpp"
 #include "rigcal/calib/lidar_lidar_calibration.hpp"
 #include "rigcal/core/pose.hpp"
@@ -23,6 +24,9 @@ struct CalibrationOutcome {
   std::string version;                                // rigcal's
   std::map<std::string, Pose> initial_T_base_sensor;  // every sensor of the rig, from its config
   std::optional<BaseLidarResult> base;                // when base-lidar calibration ran
+  /// When base_link_from_motion is on and the ground succeeded: yaw / x from the drive, already in
+  /// base->T_base_lidar.
+  std::optional<BaseFromMotionResult> base_motion;
   std::vector<pipeline::CalibrationDataset> datasets; // one per calibration lidar (may lack a result)
   std::vector<LidarLidarResult> lidars;               // one per dataset that was calibrated
   /// The mapper's whole map (map frame, already voxelised): map.pcd and the overview draw it as it is.

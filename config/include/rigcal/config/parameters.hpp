@@ -82,6 +82,9 @@ struct Parameters {
   double base_lidar_min_plane_points_percentage = 10.0;
   double base_lidar_max_cos_distance = 0.5;
   bool base_lidar_overwrite_xy_yaw = false;
+  // rigcal: base_link yaw ("yaw") or yaw and x ("yaw_x") from the mapping lidar's motion (rear-axle
+  // base_link, no side slip); "off" keeps them from the initial guess (README).
+  std::string base_link_from_motion = "off";
 };
 
 }  // namespace rigcal::config

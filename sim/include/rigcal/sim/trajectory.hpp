@@ -6,7 +6,9 @@
 //
 // Smoothness: speed changes follow a smoothstep (acceleration continuous, zero at segment ends) and a
 // turn spreads its heading change with a raised-cosine curvature, so position is C2 and heading C1 in
-// time. base_link sits on the ground midway between the axles, x forward, z up.
+// time. base_link sits on the ground midway between the axles (or on the rear axle, base_link_on_rear_axle),
+// x forward, z up. base_link's origin moves along its x axis (no side slip: the kinematic rear axle)
+// unless side_slip_rad_per_g turns its velocity off the axis, toward the outside of a turn.
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,6 +47,8 @@ struct TrajectorySpec {
   Excitation excitation;
   double wheelbase_m = 2.7;
   double track_m = 1.6;
+  bool base_link_on_rear_axle = false;  // the wheels' ground contact: rear axle at base_link (Autoware)
+  double side_slip_rad_per_g = 0.0;     // slip angle of base_link's velocity per g of lateral acceleration
 };
 
 class Trajectory {
@@ -73,7 +77,7 @@ class Trajectory {
     double t0, duration, v0, v1, s0, length, h0, turn;
   };
   struct State {
-    double s, v, a, h;  // arc length, speed, acceleration, heading
+    double s, v, a, h, k;  // arc length, speed, acceleration, heading, path curvature (1/m)
   };
   [[nodiscard]] State state(double t_s) const;
   [[nodiscard]] Eigen::Vector2d velocity(double t_s) const;
