@@ -17,6 +17,16 @@ std::map<std::string, Pose> CalibrationOutcome::T_base_sensor() const {
   return out;
 }
 
+std::string CalibrationOutcome::status() const {
+  bool unverified = false;
+  for (const auto& r : lidars) {
+    if (r.verdict == Verdict::kFailed) return "failed";
+    unverified = unverified || r.verdict == Verdict::kUnverified;
+  }
+  if (!failure.empty() || (base && !base->ok)) return "failed";
+  return unverified ? "unverified" : "ok";
+}
+
 const LidarLidarResult* CalibrationOutcome::lidar(const std::string& sensor) const {
   for (const auto& r : lidars)
     if (r.calibration_sensor == sensor) return &r;

@@ -15,12 +15,42 @@ void writeXyzRpy(std::ostream& out, const std::string& indent, const Pose& T) {
   out << indent << "roll: " << v.roll << "\n" << indent << "pitch: " << v.pitch << "\n" << indent << "yaw: " << v.yaw << "\n";
 }
 
+/// A YAML double-quoted scalar (the failure text may hold quotes, colons or backslashes).
+std::string quoted(const std::string& text) {
+  std::string q = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c == '\n' ? ' ' : c;
+  }
+  return q + "\"";
+}
+
+std::string failedCalibrationYaml(const CalibrationOutcome& o) {
+  std::ostringstream out;
+  out << "# rigcal " << o.version << ": the calibration of rig '" << o.rig_name
+      << "' FAILED; this file holds no extrinsic (see report.json)\n"
+      << "status: failed\nfailure: " << quoted(o.failure) << "\n";
+  return out.str();
+}
+
+std::string lidarComment(const LidarLidarResult& r) {
+  if (!r.ok) return "  # not calibrated: the initial guess";
+  if (r.verdict == Verdict::kUnverified) return "  # unverified: " + r.doubt;
+  return "";
+}
+
 }  // namespace
 
 std::string calibrationYaml(const CalibrationOutcome& o) {
+  if (!o.failure.empty()) return failedCalibrationYaml(o);
   std::ostringstream out;
   out << "# rigcal " << o.version << " calibration of rig '" << o.rig_name << "'\n"
-      << "# parent:\n#   child: T_parent_child as x y z (m) roll pitch yaw (rad), R = Rz(yaw)*Ry(pitch)*Rx(roll)\n";
+      << "# parent:\n#   child: T_parent_child as x y z (m) roll pitch yaw (rad), R = Rz(yaw)*Ry(pitch)*Rx(roll)\n"
+      << "# status: ok = every result confirmed; unverified / failed: see the comments and report.json\n"
+      << "status: " << o.status() << "\n";
+  if (!o.base && !o.base_skipped.empty())
+    out << "# " << o.base_frame << " -> " << o.mapping_sensor << ": not calibrated (" << o.base_skipped
+        << "): the initial extrinsic\n";
   // base_link -> mapping lidar (the base-lidar calibration: z, roll, pitch from the ground).
   out << o.base_frame << ":\n  " << o.mapping_sensor << ":\n";
   writeXyzRpy(out, "    ", o.T_base_mapping());
@@ -28,13 +58,14 @@ std::string calibrationYaml(const CalibrationOutcome& o) {
   if (!o.lidars.empty()) {
     out << o.mapping_sensor << ":\n";
     for (const auto& r : o.lidars) {
-      out << "  " << r.calibration_sensor << ":" << (r.ok ? "" : "  # not calibrated: the initial guess") << "\n";
+      out << "  " << r.calibration_sensor << ":" << lidarComment(r) << "\n";
       writeXyzRpy(out, "    ", r.ok ? r.T_mapping_calib : r.T_mapping_calib_guess);
     }
   }
   out << "# every sensor in " << o.base_frame << "\nT_base_sensor:\n";
   for (const auto& [name, T] : o.T_base_sensor()) {
-    out << "  " << name << ":\n";
+    const LidarLidarResult* r = o.lidar(name);
+    out << "  " << name << ":" << (r != nullptr ? lidarComment(*r) : "") << "\n";
     writeXyzRpy(out, "    ", T);
   }
   return out.str();

@@ -7,6 +7,7 @@
 
 #include "lidar_lidar_calibrator.hpp"
 #include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/lidar_lidar_verdict.hpp"
 
 namespace rigcal::calib {
 
@@ -41,6 +42,7 @@ LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset
         << out.deadline_share_s << " s; " << out.failure;
     out.failure = msg.str();
   }
+  judgeLidarLidar(out, dataset.frames.size(), params.calibration_deadline_s);
   return out;
 }
 

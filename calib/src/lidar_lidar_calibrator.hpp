@@ -72,6 +72,10 @@ class Calibrator {
   /// Exhaustive pass: each registrator from every candidate so far not yet tried with it on this frame.
   void frameEnsemble(std::size_t k, bool exhaustive);
 
+  /// One cheap registration of frame k alone (ICP fine from the best so far): where that frame puts the
+  /// lidar, so that the verdict can check that the frames agree before the deadline cuts the full ensembles.
+  void confirmOnFrame(std::size_t k);
+
   /// Batched ICP over all frames at 0.5 → 0.1 → 0.05 m from `start`.
   void batchedChain(const Pose& start);
 

@@ -44,6 +44,7 @@ void Calibrator::frameEnsemble(std::size_t k, bool exhaustive) {
           fits(deadline_, score_seconds_ / 2)) {
         run.frame_score = scoreFrame(*f.target, f.source, res.T_target_source, d_eval, opt_.num_threads).value;
         const std::size_t id = addCandidate(res.T_target_source);
+        run.result = id;
         if (run.frame_score < reg_best_score) {
           reg_best_score = run.frame_score;
           reg_best = id;
@@ -62,6 +63,29 @@ void Calibrator::frameEnsemble(std::size_t k, bool exhaustive) {
       if (!samePose(out_.candidates[frame_best], best_)) consider(out_.candidates[frame_best], winner);
     }
   }
+}
+
+void Calibrator::confirmOnFrame(std::size_t k) {
+  const Frame& f = frames_[k];
+  const Registrator r = Registrator::kIcpFine;
+  RegistratorRun run;
+  run.frame = int(f.index);
+  run.registrator = toString(r);
+  run.start = addCandidate(best_);
+  if (!tried_.insert({f.index, int(r), run.start}).second) return;
+  const auto tr = Clock::now();
+  const auto res = runRegistrator(r, *f.target, f.source, best_, params_, opt_.num_threads, registrationDeadline());
+  run.seconds = since(tr);
+  run.iterations = res.iterations;
+  run.status = std::string(registration::toString(res.status));
+  if (res.status != registration::Status::kInvalidInput && res.status != registration::Status::kTooFewCorrespondences &&
+      finitePose(res.T_target_source) && fits(deadline_, score_seconds_ / 2)) {
+    run.frame_score = scoreFrame(*f.target, f.source, res.T_target_source, params_.calibration_eval_max_corr_distance,
+                                 opt_.num_threads)
+                          .value;
+    run.result = addCandidate(res.T_target_source);
+  }
+  out_.runs.push_back(run);
 }
 
 void Calibrator::batchedChain(const Pose& start) {
@@ -85,7 +109,7 @@ void Calibrator::batchedChain(const Pose& start) {
       return;
     }
     T = res.T_target_source;
-    addCandidate(T);
+    run.result = addCandidate(T);
     consider(T, &run);
     out_.runs.push_back(run);
   }

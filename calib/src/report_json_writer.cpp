@@ -67,8 +67,21 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
     return j;
   }
   j["calibrated"] = true;
-  j["ok"] = r->ok;
+  j["ok"] = r->ok;  // beats the guess's score (the verdict says whether the evidence confirms it)
   if (!r->ok) j["failure"] = r->failure;
+  j["verdict"] = toString(r->verdict);
+  if (r->verdict == Verdict::kUnverified) j["doubt"] = r->doubt;
+  const LidarLidarEvidence& e = r->evidence;
+  j["evidence"] = {{"improvement", e.improvement},
+                   {"frames_selected", e.frames_selected},
+                   {"frames_registered", e.frames_registered},
+                   {"frames_agreeing", e.frames_agreeing},
+                   {"frame_spread_m", e.frame_spread_m},
+                   {"frame_spread_deg", e.frame_spread_deg},
+                   {"registrators_agreeing", e.registrators_agreeing},
+                   {"inlier_ratio", e.inlier_ratio},
+                   {"clock_offset_ms", e.clock_offset_ms}};
+  if (e.suggested_deadline_s > 0) j["evidence"]["suggested_deadline_s"] = e.suggested_deadline_s;
   j["deadline_reached"] = r->deadline_reached;  // this lidar ran out of time (its result is the best so far)
   if (r->deadline_share_s >= 0) j["deadline_share_s"] = r->deadline_share_s;
   j["result"] = xyzRpy(r->T_mapping_calib);
@@ -114,12 +127,15 @@ json reportJson(const CalibrationOutcome& o) {
   j["base_frame"] = o.base_frame;
   j["mapping_sensor"] = o.mapping_sensor;
   j["deadline_s"] = o.deadline_s;
+  j["status"] = o.status();
+  if (!o.failure.empty()) j["failure"] = o.failure;
   json stages = json::object();
   for (const auto& [name, s] : o.stage_seconds) stages[name] = s;
   j["stage_seconds"] = stages;
   json input = json::object();
   for (const auto& [k, v] : o.input_summary) input[k] = v;
   j["input"] = input;
+  j["warnings"] = o.warnings;
   if (o.base) {
     json b = {{"ok", o.base->ok}, {"cropped_points", o.base->cropped_points}};
     if (!o.base->ok) b["failure"] = o.base->failure;
@@ -159,6 +175,8 @@ json reportJson(const CalibrationOutcome& o) {
                      {"residual_rms_m", m->residual_rms_m}};
     }
     j["base_lidar"] = b;
+  } else if (!o.base_skipped.empty()) {
+    j["base_lidar_skipped"] = o.base_skipped;
   }
   const auto it = o.initial_T_base_sensor.find(o.mapping_sensor);
   if (it != o.initial_T_base_sensor.end()) j["base_lidar_initial"] = xyzRpy(it->second);

@@ -45,12 +45,17 @@ std::string summaryTable(const CalibrationOutcome& o) {
     }
     char score[96];
     std::snprintf(score, sizeof score, "%.4f, %.2f", r->final_score.rmse, r->final_score.inlier_ratio);
-    const std::string result = !r->ok ? "FAILED" : r->deadline_reached ? "ok (dl)" : "ok";
+    const std::string result = r->verdict == Verdict::kFailed       ? "FAILED"
+                               : r->verdict == Verdict::kUnverified ? "unverified"
+                               : r->deadline_reached                ? "ok (dl)"
+                                                                    : "ok";
     out << row(pair, result, r->ok ? r->T_mapping_calib : r->T_mapping_calib_guess, r->T_mapping_calib_guess, score,
                std::to_string(r->frames_used.size()) + "/" + std::to_string(d.frames.size()));
   }
   for (const auto& r : o.lidars) {
     if (!r.ok) out << "  " << r.calibration_sensor << ": " << r.failure << "\n";
+    else if (r.verdict == Verdict::kUnverified)
+      out << "  " << r.calibration_sensor << ": unverified (not called ok): " << r.doubt << "\n";
     else if (r.deadline_reached && r.deadline_share_s >= 0) {
       char line[160];
       std::snprintf(line, sizeof line, "  %s: ran out of time (its share %.1f s of the %.0f s deadline); best result so far\n",
@@ -58,6 +63,7 @@ std::string summaryTable(const CalibrationOutcome& o) {
       out << line;
     }
   }
+  for (const auto& w : o.warnings) out << "  warning: " << w << "\n";
   if (o.base && !o.base->ok) out << "  " << o.mapping_sensor << " (base): " << o.base->failure << "\n";
   if (o.base && o.base->ok) {
     // Which parts of base_link -> mapping lidar came from where.
@@ -65,7 +71,11 @@ std::string summaryTable(const CalibrationOutcome& o) {
     if (o.base_motion) out << describeBaseFromMotion(*o.base_motion) << "\n";
     else out << "x, y, yaw from the guess (base_link_from_motion: off)\n";
   }
-  out << "  ok (dl) = best result when the deadline (" << o.deadline_s << " s) was reached; dt, dr = change from the initial guess\n";
+  if (!o.base && !o.base_skipped.empty())
+    out << "  " << o.base_frame << " -> " << o.mapping_sensor << ": not calibrated (" << o.base_skipped
+        << "); calibration.yaml keeps its initial extrinsic\n";
+  out << "  ok (dl) = best result when the deadline (" << o.deadline_s << " s) was reached, confirmed by its frames and"
+         " registrators; unverified = beats the guess but not confirmed; dt, dr = change from the initial guess\n";
   return out.str();
 }
 

@@ -166,6 +166,28 @@ MappingResult Pipeline::mapping(bool with_dense_cloud) const {
   return r;
 }
 
+std::vector<SensorInput> Pipeline::inputs() const {
+  std::vector<SensorInput> out;
+  std::lock_guard lock(impl_->sources_mutex);  // the driver threads are joined after finish()
+  for (std::size_t d = 0; d < impl_->drivers.size(); ++d) {
+    const SensorDriver& drv = *impl_->drivers[d];
+    const auto& a = drv.assemblerStats();
+    const auto& src = drv.sourceStats();
+    SensorInput in;
+    in.sensor = impl_->sensors[std::size_t(impl_->driver_sensor[d])];
+    in.packets = a.packets;
+    in.lost_packets = a.lost_packets;
+    in.malformed = a.malformed + src.malformed;
+    in.late_dropped = a.late_dropped;
+    in.fragments_dropped = src.fragments_dropped;
+    in.last_error = a.last_error;
+    in.warning = drv.warning();
+    in.clock_lag_ms = drv.clockLagMs();
+    out.push_back(std::move(in));
+  }
+  return out;
+}
+
 std::vector<Shortfall> Pipeline::shortfalls() const {
   std::lock_guard lock(impl_->result_mutex);
   return impl_->shortfalls;

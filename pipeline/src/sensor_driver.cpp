@@ -1,5 +1,6 @@
 #include "rigcal/pipeline/sensor_driver.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "rigcal/drivers/paced_source.hpp"
@@ -25,12 +26,34 @@ drivers::PacketFilter filterFor(const config::SensorConfig& sensor) {
   if (sensor.source.address) f.source_address = drivers::parseIpv4(*sensor.source.address);
   return f;
 }
+constexpr std::size_t kMaxLags = 4096;  // sweeps kept for the clock-lag median (7 min at 10 Hz)
 }  // namespace
+
+/// Passes packets through and remembers the receive time of the last one (driver thread only).
+class SensorDriver::ReceiveTimeTap : public drivers::PacketSource {
+ public:
+  explicit ReceiveTimeTap(drivers::PacketSource& inner) : inner_(inner) {}
+  std::optional<drivers::UdpPacket> next() override {
+    auto p = inner_.next();
+    if (p) last_receive_ns = p->receive_ns;
+    return p;
+  }
+  [[nodiscard]] const drivers::SourceStats& stats() const override { return inner_.stats(); }
+  [[nodiscard]] std::string warning() const override { return inner_.warning(); }
+  TimeNs last_receive_ns = 0;
+
+ private:
+  drivers::PacketSource& inner_;
+};
 
 SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput& input,
                            const std::atomic<bool>& stop, drivers::ScanAssembler::ScanCallback on_scan)
     : sensor_(sensor),
-      assembler_(sensor.name, drivers::AssemblerConfig{sensor.cut_angle_deg}, std::move(on_scan)),
+      assembler_(sensor.name, drivers::AssemblerConfig{sensor.cut_angle_deg},
+                 [this, forward = std::move(on_scan)](Scan&& scan) {
+                   recordLag(scan);
+                   forward(std::move(scan));
+                 }),
       stop_(stop),
       live_(!input.pcap) {
   try {
@@ -45,6 +68,7 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
       if (sensor.source.multicast_group) udp.multicast_group = *sensor.source.multicast_group;
       source_ = std::make_unique<drivers::UdpSource>(udp);
     }
+    tap_ = std::make_unique<ReceiveTimeTap>(*source_);
   } catch (const std::exception& e) {
     throw std::runtime_error("sensor '" + sensor.name + "': " + e.what());
   }
@@ -53,13 +77,28 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
 SensorDriver::~SensorDriver() = default;
 
 void SensorDriver::run(const std::function<void()>& idle) {
-  drivers::pumpScans(*source_, *decoder_, assembler_, [&](bool was_idle) {
+  drivers::pumpScans(*tap_, *decoder_, assembler_, [&](bool was_idle) {
     if (stop_.load(std::memory_order_relaxed)) return false;
     if (!was_idle) return true;
     if (!live_) return false;  // a pcap that yields nothing has ended
     if (idle) idle();
     return true;
   });
+}
+
+void SensorDriver::recordLag(const Scan& scan) {
+  if (scan.empty() || tap_ == nullptr || tap_->last_receive_ns == 0) return;
+  const TimeNs end = scan.stamp_ns + *std::max_element(scan.offset_ns.begin(), scan.offset_ns.end());
+  std::lock_guard lock(lag_mutex_);
+  if (lags_ms_.size() < kMaxLags) lags_ms_.push_back(double(tap_->last_receive_ns - end) * 1e-6);
+}
+
+std::optional<double> SensorDriver::clockLagMs() const {
+  std::lock_guard lock(lag_mutex_);
+  if (lags_ms_.empty()) return std::nullopt;
+  std::vector<double> v = lags_ms_;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
 }
 
 }  // namespace rigcal::pipeline

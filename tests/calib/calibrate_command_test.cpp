@@ -5,6 +5,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 #include <nlohmann/json.hpp>
 
 #include "../apps/run_command.hpp"
@@ -104,6 +106,18 @@ TEST(CalibrateCommand, NoCalibrationLidarPacketsIsNotEnoughDataWithAPartialRepor
   EXPECT_TRUE(j["input"].contains("left_missing")) << j.dump(2);
   EXPECT_EQ(j["input"]["left_scans"], "0");
   EXPECT_NE(r.out.find("parent -> child"), std::string::npos) << r.out;
+  // The failure, not the initial guess under the normal header: no extrinsic a reader could take for a result.
+  const std::string yaml = [&] {
+    std::ifstream y(out / "calibration.yaml");
+    return std::string((std::istreambuf_iterator<char>(y)), std::istreambuf_iterator<char>());
+  }();
+  EXPECT_NE(yaml.find("status: failed"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("left"), std::string::npos) << "the failure names the lidar: " << yaml;
+  EXPECT_EQ(yaml.find("T_base_sensor"), std::string::npos) << yaml;
+  EXPECT_EQ(j["status"], "failed");
+  // Base-lidar calibration is off by default: the summary and the report say so.
+  EXPECT_NE(r.out.find("calibrate_base_frame: false"), std::string::npos) << r.out;
+  EXPECT_TRUE(j.contains("base_lidar_skipped")) << j.dump(2);
 }
 
 }  // namespace

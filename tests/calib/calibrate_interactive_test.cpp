@@ -207,7 +207,9 @@ perturbation: {translation_m: 0.3, rotation_deg: 5.0}
   std::printf("signalled at: %s\n", progressLines(run.text).back().c_str());
   run.signal(SIGINT);
   const int code = run.wait(std::chrono::seconds(60));
-  EXPECT_EQ(code, 0) << run.text;
+  // With --deadline 3 on a loaded machine the plan may end before a second frame confirmed the result: it
+  // is then `unverified` (exit 6) and names the --deadline that would do; never a failure.
+  EXPECT_TRUE(code == 0 || (code == 6 && run.text.find("try --deadline") != std::string::npos)) << code << run.text;
   EXPECT_NE(run.text.find("parent -> child"), std::string::npos) << "the summary table:\n" << run.text;
   const auto report = readJson(out / "report.json");
   EXPECT_EQ(report["input"]["interrupted"], "yes") << report.dump(2);

@@ -3,6 +3,7 @@
 // pipeline's CalibrationDataset, in bounded time. See ensemble_plan.hpp for the order of the work,
 // calibration_score.hpp for the score, augmented_target.hpp / calibration_source.hpp for the clouds.
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -32,11 +33,32 @@ struct RegistratorRun {
   std::string registrator;    // ndt, gicp, icp_coarse, icp_fine, icp_ultra_fine, batched_icp
   double max_distance = 0.0;  // correspondence distance (m)
   std::size_t start = 0;      // index into LidarLidarResult::candidates it started from
+  std::size_t result = SIZE_MAX;  // index into candidates of its result; SIZE_MAX = none (failed, out of time)
   double seconds = 0.0;
   int iterations = 0;
   std::string status;
   double frame_score = -1.0;  // its own frame's score (m²); −1 = not computed (batched, or out of time)
   double score = -1.0;        // all-frames score (m²); −1 = not computed (not its frame's best)
+};
+
+/// What a result is worth, judged against its own evidence (lidar_lidar_verdict.hpp): `ok` only when it
+/// beats the guess AND frames and registrators agree on it with a sane inlier ratio.
+enum class Verdict { kOk, kUnverified, kFailed };
+
+const char* toString(Verdict v);
+
+/// The evidence behind the verdict (report.json's "evidence").
+struct LidarLidarEvidence {
+  double improvement = 0.0;          // 1 − final/initial score: share of the guess's score removed
+  std::size_t frames_selected = 0;   // frames the dataset offered
+  std::size_t frames_registered = 0; // frames that got at least one scored per-frame registration
+  std::size_t frames_agreeing = 0;   // of those, frames whose own best result lies near the final one
+  double frame_spread_m = 0.0;       // largest distance of a frame's own best result from the final one
+  double frame_spread_deg = 0.0;
+  std::vector<std::string> registrators_agreeing;  // registrators with a result near the final one
+  double inlier_ratio = 0.0;         // of the final score
+  double suggested_deadline_s = 0.0; // > 0: the calibration_deadline_s (--deadline) that would confirm it
+  double clock_offset_ms = 0.0;      // its packet clock against the mapping lidar's (both vs capture time)
 };
 
 struct LidarLidarResult {
@@ -56,6 +78,9 @@ struct LidarLidarResult {
   std::vector<RegistratorRun> runs;
   std::vector<std::pair<std::string, double>> stage_seconds;  // targets, ensemble, batched, redeskew+final
   double seconds = 0.0;
+  Verdict verdict = Verdict::kFailed;  // kOk needs ok and the evidence; kUnverified: ok but not confirmed
+  std::string doubt;                   // one line when verdict is kUnverified: why, and what is missing
+  LidarLidarEvidence evidence;
 };
 
 /// Empty when `dataset` can be calibrated, else one line naming the field that is wrong.

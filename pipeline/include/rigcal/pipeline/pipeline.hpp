@@ -122,6 +122,21 @@ struct Shortfall {
   std::string message;  // "1 of 2 frames for left: drive further or lower lidar_calibration_min_frames"
 };
 
+/// One sensor's input as its driver saw it (pcap or live input; complete after finish()): what a damaged
+/// capture or a lossy network cost, and the sensor's clock against the capture / receive time.
+struct SensorInput {
+  std::string sensor;
+  std::uint64_t packets = 0;            // data packets decoded
+  std::uint64_t lost_packets = 0;       // gaps in the sensor's packet sequence
+  std::uint64_t malformed = 0;          // packets and frames dropped as malformed (decoder and source)
+  std::uint64_t late_dropped = 0;       // packets older than one already assembled
+  std::uint64_t fragments_dropped = 0;  // IPv4 fragments never completed (of every sensor in the capture)
+  std::string last_error;               // the latest malformed packet's reason
+  std::string warning;                  // the capture ended abnormally (e.g. truncated mid-record)
+  std::optional<double> clock_lag_ms;   // SensorDriver::clockLagMs()
+  [[nodiscard]] bool damaged() const { return lost_packets + malformed + late_dropped > 0 || !warning.empty(); }
+};
+
 class Pipeline {
  public:
   /// Called on the selector thread, once per calibration lidar. Return quickly (hand the dataset to
@@ -152,6 +167,7 @@ class Pipeline {
   /// A snapshot; complete after finish(). `with_dense_cloud` also merges the dense cloud (seconds).
   [[nodiscard]] MappingResult mapping(bool with_dense_cloud = false) const;
   [[nodiscard]] std::vector<Shortfall> shortfalls() const;  // after finish()
+  [[nodiscard]] std::vector<SensorInput> inputs() const;    // after finish(); empty for kInProcess / kShm
 
  private:
   struct Impl;

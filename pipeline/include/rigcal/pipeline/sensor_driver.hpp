@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <vector>
 
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
@@ -38,6 +40,10 @@ class SensorDriver {
   [[nodiscard]] const drivers::AssemblerStats& assemblerStats() const { return assembler_.stats(); }
   [[nodiscard]] const drivers::SourceStats& sourceStats() const { return source_->stats(); }
   [[nodiscard]] std::string warning() const { return source_->warning(); }
+  /// The median over sweeps of (capture / receive time of the packet that closed the sweep − the sensor's
+  /// time of the sweep's last point), in ms; nullopt before the first sweep. Sensors whose clocks agree
+  /// show the same lag within the network's and the assembler's few ms (see SensorClockCheck).
+  [[nodiscard]] std::optional<double> clockLagMs() const;
 
  private:
   config::SensorConfig sensor_;
@@ -47,6 +53,11 @@ class SensorDriver {
   drivers::ScanAssembler assembler_;
   const std::atomic<bool>& stop_;
   bool live_ = false;
+  void recordLag(const Scan& scan);
+  class ReceiveTimeTap;
+  std::unique_ptr<ReceiveTimeTap> tap_;  // wraps source_: remembers the last packet's receive time
+  mutable std::mutex lag_mutex_;
+  std::vector<double> lags_ms_;  // one per sweep (the first kMaxLags)
 };
 
 }  // namespace rigcal::pipeline

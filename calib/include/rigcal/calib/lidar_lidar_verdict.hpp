@@ -1,0 +1,33 @@
+#pragma once
+// The quality gate of a lidar-lidar result. Beating the guess's score is not enough to call a result ok:
+// a side-mounted lidar came out 42 cm off (worse than its guess) with a better score, an inlier ratio of
+// 0.49 and 3 of 7 frames registered before the deadline. A result is `ok` only when its own evidence
+// confirms it: at least two frames whose own best registration lands near it (and no more frames
+// against it than for it), at least two registrators that reach it, and an inlier ratio that says the
+// clouds really overlap. Otherwise it is `unverified`, with the reason and what is missing (the
+// `--deadline` that would do when the deadline cut the plan).
+#include <cstddef>
+
+#include "rigcal/calib/lidar_lidar_calibration.hpp"
+
+namespace rigcal::calib {
+
+struct VerdictOptions {
+  double agree_m = 0.05;      // a result this close to the final one confirms it (per-frame results of a
+  double agree_deg = 0.5;     // 16-beam lidar scatter by 1-2 cm / 0.1-0.2°)
+  std::size_t min_frames = 2;
+  std::size_t min_registrators = 2;
+  double min_inlier_ratio = 0.5;  // measured 0.66-0.94 for good results, 0.49 for the 42 cm one
+};
+
+/// Fills result.evidence, result.verdict and result.doubt. `frames_selected` is the dataset's frame
+/// count, `deadline_s` the calibration_deadline_s the run had (for the suggested --deadline).
+void judgeLidarLidar(LidarLidarResult& result, std::size_t frames_selected, double deadline_s,
+                     const VerdictOptions& options = {});
+
+/// A lidar whose packet clock is `offset_ms` off the mapping lidar's (each against the capture / receive
+/// time) is paired with the wrong mapping pose: 50 ms at walking speed put a lidar 7 cm off with a normal
+/// score. Records the offset; above `limit_ms` a result is not called ok (the sensor and the offset named).
+void doubtClockOffset(LidarLidarResult& result, double offset_ms, double limit_ms);
+
+}  // namespace rigcal::calib

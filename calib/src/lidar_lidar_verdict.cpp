@@ -1,0 +1,119 @@
+#include "rigcal/calib/lidar_lidar_verdict.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace rigcal::calib {
+namespace {
+
+struct Distance {
+  double m = 0.0, deg = 0.0;
+};
+
+Distance distance(const Pose& a, const Pose& b) {
+  return {(a.translation() - b.translation()).norm(), rad2deg(rotationAngleBetween(a, b))};
+}
+
+/// The calibration_deadline_s that gives every selected frame its ensemble, from the share of frames
+/// this one reached: at least twice the deadline it had, rounded up to 10 s.
+double suggestDeadline(double deadline_s, std::size_t frames_selected, std::size_t frames_registered) {
+  const double ratio = std::max(2.0, double(frames_selected) / double(std::max<std::size_t>(1, frames_registered)));
+  return std::ceil(deadline_s * ratio / 10.0) * 10.0;
+}
+
+}  // namespace
+
+const char* toString(Verdict v) {
+  switch (v) {
+    case Verdict::kOk: return "ok";
+    case Verdict::kUnverified: return "unverified";
+    case Verdict::kFailed: return "failed";
+  }
+  return "?";
+}
+
+void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double deadline_s, const VerdictOptions& opt) {
+  LidarLidarEvidence& e = r.evidence;
+  e = {};
+  e.frames_selected = frames_selected;
+  e.inlier_ratio = r.final_score.inlier_ratio;
+  if (r.initial_score.value > 0) e.improvement = 1.0 - r.final_score.value / r.initial_score.value;
+  if (!r.ok) {
+    r.verdict = Verdict::kFailed;
+    return;
+  }
+  const auto near = [&](const Distance& d) { return d.m <= opt.agree_m && d.deg <= opt.agree_deg; };
+  // Each frame's own best registration (lowest score on that frame): where that frame alone puts the lidar.
+  std::map<int, const RegistratorRun*> frame_best;
+  std::set<std::string> agreeing;
+  for (const auto& run : r.runs) {
+    if (run.result >= r.candidates.size()) continue;
+    if (near(distance(r.candidates[run.result], r.T_mapping_calib))) agreeing.insert(run.registrator);
+    if (run.frame < 0 || run.frame_score < 0) continue;
+    auto& best = frame_best[run.frame];
+    if (best == nullptr || run.frame_score < best->frame_score) best = &run;
+  }
+  e.registrators_agreeing.assign(agreeing.begin(), agreeing.end());
+  e.frames_registered = frame_best.size();
+  for (const auto& [frame, run] : frame_best) {
+    const Distance d = distance(r.candidates[run->result], r.T_mapping_calib);
+    e.frame_spread_m = std::max(e.frame_spread_m, d.m);
+    e.frame_spread_deg = std::max(e.frame_spread_deg, d.deg);
+    if (near(d)) ++e.frames_agreeing;
+  }
+
+  std::ostringstream why;
+  why.setf(std::ios::fixed);
+  why.precision(2);
+  const auto clause = [&why]() -> std::ostringstream& {
+    if (why.tellp() > 0) why << "; ";
+    return why;
+  };
+  const std::size_t disagreeing = e.frames_registered - e.frames_agreeing;
+  bool short_of_evidence = false;
+  if (e.frames_agreeing < opt.min_frames) {
+    clause() << "confirmed by " << e.frames_agreeing << " frame(s) of " << frames_selected << " (needs "
+             << opt.min_frames << ")";
+    short_of_evidence = true;
+  }
+  if (disagreeing > e.frames_agreeing)
+    clause() << disagreeing << " of " << e.frames_registered << " frames disagree (spread " << 100.0 * e.frame_spread_m
+             << " cm, " << e.frame_spread_deg << " deg)";
+  if (agreeing.size() < opt.min_registrators) {
+    clause() << "reached by " << agreeing.size() << " registrator(s) (needs " << opt.min_registrators << ")";
+    short_of_evidence = true;
+  }
+  if (e.inlier_ratio < opt.min_inlier_ratio)
+    clause() << "inlier ratio " << e.inlier_ratio << " < " << opt.min_inlier_ratio << " (little overlap or a wrong pose)";
+  if (why.tellp() == 0) {
+    r.verdict = Verdict::kOk;
+    r.doubt.clear();
+    return;
+  }
+  r.verdict = Verdict::kUnverified;
+  if (r.deadline_reached && short_of_evidence) {
+    e.suggested_deadline_s = suggestDeadline(deadline_s, frames_selected, e.frames_registered);
+    why << "; the deadline cut the plan after " << e.frames_registered << " of " << frames_selected
+        << " frames: try --deadline " << std::setprecision(0) << e.suggested_deadline_s;
+  }
+  r.doubt = why.str();
+}
+
+void doubtClockOffset(LidarLidarResult& r, double offset_ms, double limit_ms) {
+  r.evidence.clock_offset_ms = offset_ms;
+  if (std::abs(offset_ms) <= limit_ms || r.verdict == Verdict::kFailed) return;
+  std::ostringstream why;
+  why.setf(std::ios::fixed);
+  why.precision(1);
+  why << "clock: " << r.calibration_sensor << "'s packet clock is " << std::showpos << offset_ms << std::noshowpos
+      << " ms off " << r.mapping_sensor << "'s (each against the capture time; more than " << limit_ms
+      << " ms pairs it with the wrong mapping pose): fix the sensor's time sync";
+  r.doubt = r.verdict == Verdict::kUnverified ? why.str() + "; " + r.doubt : why.str();
+  r.verdict = Verdict::kUnverified;
+}
+
+}  // namespace rigcal::calib

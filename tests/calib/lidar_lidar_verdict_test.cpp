@@ -1,0 +1,108 @@
+// The lidar-lidar quality gate on results whose evidence is laid out by hand: ok needs frames and
+// registrators that agree and a sane inlier ratio; a deadline that cut the plan is named with the
+// --deadline that would do.
+#include <gtest/gtest.h>
+
+#include "rigcal/calib/lidar_lidar_verdict.hpp"
+
+namespace rigcal::calib {
+namespace {
+
+Pose at(double x, double yaw_deg = 0.0) {
+  Pose T = Pose::Identity();
+  T.translate(Eigen::Vector3d(x, 0, 0));
+  T.rotate(Eigen::AngleAxisd(deg2rad(yaw_deg), Eigen::Vector3d::UnitZ()));
+  return T;
+}
+
+/// A result that beat its guess (x = 0) at x = 1 m, with per-frame runs landing where `frame_x` says.
+LidarLidarResult resultWithFrames(const std::vector<double>& frame_x, double inliers = 0.8) {
+  LidarLidarResult r;
+  r.ok = true;
+  r.T_mapping_calib_guess = at(0);
+  r.T_mapping_calib = at(1.0);
+  r.initial_score.value = 0.01;
+  r.final_score.value = 0.002;
+  r.final_score.inlier_ratio = inliers;
+  r.candidates = {r.T_mapping_calib_guess};
+  for (std::size_t f = 0; f < frame_x.size(); ++f) {
+    for (const char* reg : {"ndt", "icp_fine"}) {
+      RegistratorRun run;
+      run.frame = int(f);
+      run.registrator = reg;
+      run.frame_score = std::string(reg) == "icp_fine" ? 0.001 : 0.003;
+      r.candidates.push_back(at(std::string(reg) == "icp_fine" ? frame_x[f] : frame_x[f] + 0.02));
+      run.result = r.candidates.size() - 1;
+      r.runs.push_back(run);
+    }
+  }
+  return r;
+}
+
+TEST(LidarLidarVerdict, AgreeingFramesAndRegistratorsAreOk) {
+  auto r = resultWithFrames({1.0, 1.01, 0.99});
+  judgeLidarLidar(r, 3, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.doubt;
+  EXPECT_EQ(r.evidence.frames_agreeing, 3u);
+  EXPECT_NEAR(r.evidence.frame_spread_m, 0.01, 1e-9);
+  EXPECT_NEAR(r.evidence.improvement, 0.8, 1e-9);
+}
+
+TEST(LidarLidarVerdict, OneConfirmingFrameCutByTheDeadlineIsUnverifiedWithTheDeadlineThatWouldDo) {
+  auto r = resultWithFrames({1.0});
+  r.deadline_reached = true;
+  judgeLidarLidar(r, 7, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_NE(r.doubt.find("confirmed by 1 frame"), std::string::npos) << r.doubt;
+  EXPECT_NE(r.doubt.find("--deadline 70"), std::string::npos) << r.doubt;
+  EXPECT_DOUBLE_EQ(r.evidence.suggested_deadline_s, 70.0);
+}
+
+TEST(LidarLidarVerdict, DisagreeingFramesAreUnverified) {
+  auto r = resultWithFrames({1.0, 1.0, 1.4, 0.6, 1.3});
+  judgeLidarLidar(r, 5, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_NE(r.doubt.find("3 of 5 frames disagree"), std::string::npos) << r.doubt;
+  EXPECT_NEAR(r.evidence.frame_spread_m, 0.4, 1e-9);
+}
+
+TEST(LidarLidarVerdict, LowInlierRatioIsUnverified) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0}, 0.49);
+  judgeLidarLidar(r, 3, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_NE(r.doubt.find("inlier ratio 0.49"), std::string::npos) << r.doubt;
+}
+
+TEST(LidarLidarVerdict, OneRegistratorAloneIsUnverified) {
+  auto r = resultWithFrames({1.0, 1.0});
+  for (auto& run : r.runs)
+    if (run.registrator == "icp_fine") run.registrator = "ndt";
+  for (std::size_t c = 1; c < r.candidates.size(); ++c) r.candidates[c] = at(1.0);
+  judgeLidarLidar(r, 2, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_NE(r.doubt.find("reached by 1 registrator"), std::string::npos) << r.doubt;
+}
+
+TEST(LidarLidarVerdict, AResultThatDoesNotBeatTheGuessFails) {
+  auto r = resultWithFrames({1.0, 1.0});
+  r.ok = false;
+  judgeLidarLidar(r, 2, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kFailed);
+}
+
+TEST(LidarLidarVerdict, AClockOffsetAboveTheLimitIsUnverifiedNamingTheSensorAndTheOffset) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0});
+  r.calibration_sensor = "front_left";
+  r.mapping_sensor = "top";
+  judgeLidarLidar(r, 3, 10.0);
+  ASSERT_EQ(r.verdict, Verdict::kOk) << r.doubt;
+  doubtClockOffset(r, 4.0, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << "within the limit: " << r.doubt;
+  doubtClockOffset(r, -50.0, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_DOUBLE_EQ(r.evidence.clock_offset_ms, -50.0);
+  EXPECT_NE(r.doubt.find("front_left's packet clock is -50.0 ms off top's"), std::string::npos) << r.doubt;
+}
+
+}  // namespace
+}  // namespace rigcal::calib
