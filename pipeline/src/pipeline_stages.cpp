@@ -32,8 +32,7 @@ void Pipeline::Impl::deskewStage() {
       if (s->end) {
         input_ended = true;
         q_map.push(std::move(*s));
-      } else if (s->sensor == 0) {
-        cropRange(*s->scan, params.mapping_min_range, params.mapping_max_range);
+      } else if (s->sensor == 0) {  // the mapper crops and deskews it
         const std::int64_t t0 = s->t0_ns;
         if (realtime) q_map.pushDropOldest(std::move(*s));
         else q_map.push(std::move(*s));
@@ -44,7 +43,7 @@ void Pipeline::Impl::deskewStage() {
     }
     while (!held.empty()) {
       const ScanItem& h = held.front();
-      const bool covered = traj_ended || (!traj.empty() && traj.last() >= scanEnd(*h.scan));
+      const bool covered = traj_ended || (!traj.empty() && traj.last() >= h.scan->endTime());
       if (!covered && !(realtime && steadyNs() - h.t0_ns > kRealtimeHoldNs)) break;
       CalItem c{h.sensor - 1, deskewCalibration(h, traj), false};
       const std::int64_t t0 = h.t0_ns;
@@ -81,7 +80,7 @@ void Pipeline::Impl::mapperStage() {
     MapperOutput out;
     {
       std::lock_guard lock(mapper_mutex);
-      out = mapper.process(*item->scan);
+      out = mapper.process(std::move(*item->scan));
       if (out.registered) trajectory.push_back(out.frame);
     }
     item->scan.reset();
