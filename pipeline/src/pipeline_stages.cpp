@@ -5,12 +5,9 @@ namespace rigcal::pipeline {
 
 DeskewedScan Pipeline::Impl::deskewCalibration(const ScanItem& item, const TrajectoryBuffer& traj) const {
   auto out = std::make_shared<Scan>(*item.scan);
-  const Pose& T_mc = T_mapping_calib[std::size_t(item.sensor - 1)];
-  if (!traj.empty()) {
-    // The calibration lidar's motion: the mapping trajectory seen through the extrinsic guess.
-    const Pose T_ref_map = (traj.at(out->stamp_ns) * T_mc).inverse();
-    deskew(*out, [&](TimeNs t) { return T_ref_map * traj.at(t) * T_mc; });
-  }
+  // The calibration lidar's motion: the mapping trajectory seen through the extrinsic guess.
+  if (!traj.empty())
+    deskewThroughMapping(*out, [&](TimeNs t) { return traj.at(t); }, T_mapping_calib[std::size_t(item.sensor - 1)]);
   return DeskewedScan{item.scan, std::move(out), item.t0_ns};
 }
 
