@@ -74,9 +74,7 @@ pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector
   for (const auto& s : scans) first = std::min(first, s.stamp_ns);
   const auto start = std::chrono::steady_clock::now();
   for (const auto& s : scans) {
-    std::uint32_t last = 0;
-    for (auto off : s.offset_ns) last = std::max(last, off);
-    const auto due = start + std::chrono::nanoseconds(s.stamp_ns + TimeNs(last) - first);
+    const auto due = start + std::chrono::nanoseconds(s.endTime() - first);
     std::this_thread::sleep_until(due);
     p.push(s);
   }

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "lidar_lidar_calibrator.hpp"
-#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_budget.hpp"
 #include "rigcal/calib/lidar_lidar_verdict.hpp"
 
 namespace rigcal::calib {
@@ -44,16 +44,6 @@ LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset
   }
   judgeLidarLidar(out, dataset.frames.size(), params.calibration_deadline_s);
   return out;
-}
-
-std::vector<LidarLidarResult> calibrateLidarsLidar(const std::vector<pipeline::CalibrationDataset>& datasets,
-                                                   const config::Parameters& params,
-                                                   const registration::CancelToken* cancel,
-                                                   const LidarLidarOptions& options) {
-  CalibrationBudget budget(Clock::now(), params.calibration_deadline_s, datasets.size(), cancel);
-  std::vector<LidarLidarResult> results;
-  for (const auto& d : datasets) results.push_back(calibrateLidarLidar(d, params, budget.next(), options));
-  return results;
 }
 
 }  // namespace rigcal::calib

@@ -4,7 +4,7 @@
 
 #include <sstream>
 
-#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_budget.hpp"
 
 namespace rigcal::calib::detail {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "rigcal/calib/calibration_deskew.hpp"
-#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_budget.hpp"
 #include "rigcal/calib/calibration_source.hpp"
 #include "rigcal/calib/ensemble_plan.hpp"
 

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "rigcal/calib/augmented_target.hpp"
-#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_budget.hpp"
 #include "rigcal/calib/calibration_source.hpp"
 
 namespace rigcal::calib::detail {

@@ -23,7 +23,6 @@ const std::vector<ParameterSpec>& parameterSpecs() {
       {"mapper_resolution", &P::mapper_resolution, 0.05, 100, {}},
       {"mapper_step_size", &P::mapper_step_size, 1e-4, 10, {}},
       {"mapper_max_iterations", &P::mapper_max_iterations, 1, 10000, {}},
-      {"mapper_epsilon", &P::mapper_epsilon, 0, 1, {}},
       {"mapper_num_threads", &P::mapper_num_threads, 1, 2, {}},
       {"mapper_max_correspondence_distance", &P::mapper_max_correspondence_distance, 1e-3, 100, {}},
       {"leaf_size_input", &P::leaf_size_input, 0, 10, {}},
@@ -46,11 +45,9 @@ const std::vector<ParameterSpec>& parameterSpecs() {
       {"lost_frame_max_angle_diff", &P::lost_frame_max_angle_diff, 0, 180, {}},
       {"lost_frame_interpolation_error", &P::lost_frame_interpolation_error, 0, 100, {}},
       {"lost_frame_max_acceleration", &P::lost_frame_max_acceleration, 0, 1000, {}},
-      {"viz_max_range", &P::viz_max_range, 0, 1000, {}},
       {"crop_z_calibration_pointclouds", &P::crop_z_calibration_pointclouds, 0, 0, {}},
       {"crop_z_calibration_pointclouds_value", &P::crop_z_calibration_pointclouds_value, -100, 100, {}},
       {"calibration_use_only_stopped", &P::calibration_use_only_stopped, 0, 0, {}},
-      {"calibration_use_only_last_frames", &P::calibration_use_only_last_frames, 0, 0, {}},
       {"max_calibration_range", &P::max_calibration_range, 0.1, 1000, {}},
       {"min_calibration_range", &P::min_calibration_range, 0, 1000, {}},
       {"calibration_min_pca_eigenvalue", &P::calibration_min_pca_eigenvalue, 0, 1000, {}},
@@ -89,6 +86,9 @@ const std::vector<std::string>& ignoredUpstreamParameters() {
       "mapping_viz_leaf_size", "calibration_viz_leaf_size", "filter_detections",
       "detection_max_time_tolerance", "detection_size_tolerance", "camera_calibration_min_frames",
       "camera_calibration_max_frames", "pc_features_min_distance", "pc_features_max_distance",
+      // Read by upstream, not by rigcal: our GICP/NDT stop on their own step criteria (not
+      // mapper_epsilon), there is no visualiser (viz_max_range), and pairing has no last-frames mode.
+      "mapper_epsilon", "viz_max_range", "calibration_use_only_last_frames",
   };
   return names;
 }

@@ -19,7 +19,8 @@ struct ParameterSpec {
 
 const std::vector<ParameterSpec>& parameterSpecs();
 
-/// Upstream parameter names that rigcal accepts but does not use (cameras, object detections, ROS).
+/// Upstream parameter names that rigcal accepts but does not use (cameras, object detections, ROS, and
+/// upstream tuning rigcal has no counterpart for), each with a warning.
 const std::vector<std::string>& ignoredUpstreamParameters();
 
 }  // namespace rigcal::config::detail

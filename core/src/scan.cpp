@@ -1,5 +1,6 @@
 #include "rigcal/core/scan.hpp"
 
+#include <algorithm>
 #include <cassert>
 
 namespace rigcal {
@@ -44,6 +45,12 @@ void Scan::push_back(const Point& p) {
   ring.push_back(p.ring);
   offset_ns.push_back(static_cast<std::uint32_t>(p.time_ns - stamp_ns));
   return_index.push_back(p.return_index);
+}
+
+TimeNs Scan::endTime() const {
+  std::uint32_t latest = 0;
+  for (std::uint32_t o : offset_ns) latest = std::max(latest, o);
+  return stamp_ns + TimeNs(latest);
 }
 
 Point Scan::point(std::size_t i) const {

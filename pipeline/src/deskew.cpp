@@ -26,4 +26,10 @@ void deskew(Scan& scan, const SensorMotion& T_ref_sensor, TimeNs bin_ns) {
   }
 }
 
+void deskewThroughMapping(Scan& scan, const TrajectoryLookup& T_map_mapping, const Pose& T_mapping_calib) {
+  if (scan.empty()) return;
+  const Pose T_ref_map = (T_map_mapping(scan.stamp_ns) * T_mapping_calib).inverse();
+  deskew(scan, [&](TimeNs t) { return Pose(T_ref_map * T_map_mapping(t) * T_mapping_calib); });
+}
+
 }  // namespace rigcal::pipeline

@@ -155,14 +155,11 @@ MappingResult Pipeline::mapping(bool with_dense_cloud) const {
                                                                  m.stored_frames[i].T_map_lidar);
     merged.points.insert(merged.points.end(), c.points.begin(), c.points.end());
   }
-  auto dense = std::make_shared<Scan>();
-  dense->sensor_id = m.sensors[0];
-  dense->stamp_ns = last_kf.stamp_ns;
-  if (!merged.empty()) {
-    for (const auto& p : registration::voxelDownsample(merged, m.params.leaf_size_dense_map).points)
-      dense->push_back(Point{float(p.x()), float(p.y()), float(p.z()), 0.0f, 0, last_kf.stamp_ns, 0});
-  }
-  r.dense_cloud = std::move(dense);
+  Scan like;
+  like.sensor_id = m.sensors[0];
+  like.stamp_ns = last_kf.stamp_ns;
+  r.dense_cloud = std::make_shared<const Scan>(
+      merged.empty() ? like : registration::toScan(registration::voxelDownsample(merged, m.params.leaf_size_dense_map), like));
   return r;
 }
 

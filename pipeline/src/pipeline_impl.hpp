@@ -87,12 +87,6 @@ struct LaneCounters {
   std::atomic<bool> handed_over{false};
 };
 
-inline TimeNs scanEnd(const Scan& s) {
-  std::uint32_t m = 0;
-  for (std::uint32_t o : s.offset_ns) m = std::max(m, o);
-  return s.stamp_ns + TimeNs(m);
-}
-
 }  // namespace rigcal::pipeline::detail
 
 namespace rigcal::pipeline {

@@ -5,12 +5,9 @@ namespace rigcal::pipeline {
 
 DeskewedScan Pipeline::Impl::deskewCalibration(const ScanItem& item, const TrajectoryBuffer& traj) const {
   auto out = std::make_shared<Scan>(*item.scan);
-  const Pose& T_mc = T_mapping_calib[std::size_t(item.sensor - 1)];
-  if (!traj.empty()) {
-    // The calibration lidar's motion: the mapping trajectory seen through the extrinsic guess.
-    const Pose T_ref_map = (traj.at(out->stamp_ns) * T_mc).inverse();
-    deskew(*out, [&](TimeNs t) { return T_ref_map * traj.at(t) * T_mc; });
-  }
+  // The calibration lidar's motion: the mapping trajectory seen through the extrinsic guess.
+  if (!traj.empty())
+    deskewThroughMapping(*out, [&](TimeNs t) { return traj.at(t); }, T_mapping_calib[std::size_t(item.sensor - 1)]);
   return DeskewedScan{item.scan, std::move(out), item.t0_ns};
 }
 
@@ -32,8 +29,7 @@ void Pipeline::Impl::deskewStage() {
       if (s->end) {
         input_ended = true;
         q_map.push(std::move(*s));
-      } else if (s->sensor == 0) {
-        cropRange(*s->scan, params.mapping_min_range, params.mapping_max_range);
+      } else if (s->sensor == 0) {  // the mapper crops and deskews it
         const std::int64_t t0 = s->t0_ns;
         if (realtime) q_map.pushDropOldest(std::move(*s));
         else q_map.push(std::move(*s));
@@ -44,7 +40,7 @@ void Pipeline::Impl::deskewStage() {
     }
     while (!held.empty()) {
       const ScanItem& h = held.front();
-      const bool covered = traj_ended || (!traj.empty() && traj.last() >= scanEnd(*h.scan));
+      const bool covered = traj_ended || (!traj.empty() && traj.last() >= h.scan->endTime());
       if (!covered && !(realtime && steadyNs() - h.t0_ns > kRealtimeHoldNs)) break;
       CalItem c{h.sensor - 1, deskewCalibration(h, traj), false};
       const std::int64_t t0 = h.t0_ns;
@@ -81,7 +77,7 @@ void Pipeline::Impl::mapperStage() {
     MapperOutput out;
     {
       std::lock_guard lock(mapper_mutex);
-      out = mapper.process(*item->scan);
+      out = mapper.process(std::move(*item->scan));
       if (out.registered) trajectory.push_back(out.frame);
     }
     item->scan.reset();

@@ -1,5 +1,7 @@
 #include "trajectory_buffer.hpp"
 
+#include "rigcal/pipeline/deskew.hpp"
+
 #include <algorithm>
 
 namespace rigcal::pipeline {
@@ -11,12 +13,8 @@ void TrajectoryBuffer::add(TimeNs stamp, const Pose& T_map_lidar) {
 }
 
 Pose TrajectoryBuffer::at(TimeNs t) const {
-  if (stamps_.empty()) return Pose::Identity();
-  const auto after = std::upper_bound(stamps_.begin(), stamps_.end(), t);
-  if (after == stamps_.begin()) return poses_.front();
-  if (after == stamps_.end()) return poses_.back();
-  const std::size_t r = std::size_t(after - stamps_.begin());
-  return interpolateAt(stamps_[r - 1], poses_[r - 1], stamps_[r], poses_[r], t);
+  return poseOnTrajectory(
+      stamps_.size(), [&](std::size_t i) { return stamps_[i]; }, [&](std::size_t i) { return poses_[i]; }, t);
 }
 
 void TrajectoryBuffer::trimBefore(TimeNs t) {

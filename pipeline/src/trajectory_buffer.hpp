@@ -1,6 +1,6 @@
 #pragma once
-// The mapping lidar's registered poses in time order, interpolated at any time (lerp/slerp between the
-// bracketing poses, the nearest end pose outside them). Owned by one stage thread.
+// The mapping lidar's registered poses in time order, interpolated at any time by poseOnTrajectory()
+// (deskew.hpp: the same rule as calibration's re-deskew). Owned by one stage thread.
 #include <vector>
 
 #include "rigcal/core/pose.hpp"

@@ -51,6 +51,24 @@ PointCloud fromPoints(std::span<const Eigen::Vector3d> points, std::size_t* drop
   return cloud;
 }
 
+Scan toScan(const PointCloud& cloud, const Scan& like) {
+  Scan s;
+  s.sensor_id = like.sensor_id;
+  s.sequence = like.sequence;
+  s.stamp_ns = like.stamp_ns;
+  s.reserve(cloud.size());
+  for (const auto& p : cloud.points) {
+    s.x.push_back(float(p.x()));
+    s.y.push_back(float(p.y()));
+    s.z.push_back(float(p.z()));
+  }
+  s.intensity.assign(s.size(), 0.0f);
+  s.ring.assign(s.size(), 0);
+  s.offset_ns.assign(s.size(), 0);
+  s.return_index.assign(s.size(), 0);
+  return s;
+}
+
 PointCloud transformed(const PointCloud& cloud, const Pose& T_to_from) {
   const Eigen::Matrix4d M = T_to_from.matrix();
   PointCloud out;

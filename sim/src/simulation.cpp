@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
-#include "rigcal/sim/parallel.hpp"
+#include "rigcal/core/parallel.hpp"
 #include "rigcal/sim/random.hpp"
 
 namespace rigcal::sim {

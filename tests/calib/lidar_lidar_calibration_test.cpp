@@ -14,7 +14,7 @@
 #include "rigcal/calib/calibration_deskew.hpp"
 #include "rigcal/calib/calibration_source.hpp"
 #include "rigcal/calib/ensemble_plan.hpp"
-#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_budget.hpp"
 #include "rigcal/calib/calibration_score.hpp"
 #include "rigcal/calib/calibration_yaml_writer.hpp"
 #include "rigcal/calib/cloud_writers.hpp"
@@ -31,6 +31,16 @@ namespace rigcal::calib {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// The calibration lidars one after the other, sharing params.calibration_deadline_s from now through a
+/// CalibrationBudget (what the lidar-lidar worker does as the datasets arrive).
+std::vector<LidarLidarResult> calibrateInTurn(const std::vector<pipeline::CalibrationDataset>& datasets,
+                                              const config::Parameters& params) {
+  CalibrationBudget budget(Clock::now(), params.calibration_deadline_s, datasets.size());
+  std::vector<LidarLidarResult> results;
+  for (const auto& d : datasets) results.push_back(calibrateLidarLidar(d, params, budget.next()));
+  return results;
+}
 
 class LidarLidarSim : public ::testing::Test {
  protected:
@@ -142,7 +152,7 @@ TEST_F(LidarLidarSim, SeveralLidarsShareTheDeadlineFairly) {
   config::Parameters params = data().params;
   params.calibration_deadline_s = 2.0;
   const auto start = Clock::now();
-  const auto results = calibrateLidarsLidar(data().datasets, params);
+  const auto results = calibrateInTurn(data().datasets, params);
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   ASSERT_EQ(results.size(), 2u);
   std::printf("2 lidars, 2 s: %.3f s total; %s %.3f s, %s %.3f s\n", elapsed, results[0].calibration_sensor.c_str(),
@@ -281,7 +291,7 @@ TEST_F(LidarLidarSim, OutputsOfARealRunPutTheAfterCloudOnTheMap) {
   for (const auto& d : data().datasets)
     o.initial_T_base_sensor[d.calibration_sensor] = data().truth_T_base_mapping * d.T_mapping_calib_guess;
   o.datasets = data().datasets;
-  o.lidars = calibrateLidarsLidar(o.datasets, params);
+  o.lidars = calibrateInTurn(o.datasets, params);
   test::TempDir dir;
   // RIGCAL_KEEP_OUTPUTS=<dir>: write there instead, to look at them.
   const char* keep = std::getenv("RIGCAL_KEEP_OUTPUTS");

@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "lidar_lidar_sim_dataset.hpp"
-#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_budget.hpp"
 #include "rigcal/calib/lidar_lidar_worker.hpp"
 #include "sanitizers.hpp"
 

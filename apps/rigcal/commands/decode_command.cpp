@@ -78,10 +78,8 @@ void run(const DecodeOptions& o) {
     else
       writePcd(path, toTable(scan));
     std::cout << name << "  points " << scan.size() << "  stamp_ns " << scan.stamp_ns << "  span_ms "
-              << std::fixed << std::setprecision(2)
-              << (scan.empty() ? 0.0 : double(*std::max_element(scan.offset_ns.begin(), scan.offset_ns.end())) * 1e-6)
-              << "  missing_packets "
-              << scan.missing_packets << '\n';
+              << std::fixed << std::setprecision(2) << double(scan.endTime() - scan.stamp_ns) * 1e-6
+              << "  missing_packets " << scan.missing_packets << '\n';
     ++written;
   });
   drivers::pumpScans(*source, *decoder, assembler);

@@ -10,8 +10,9 @@
 
 namespace rigcal::calib {
 
-/// T_map_mapping at time t: lerp/slerp between the two trajectory poses around t (the nearest two at
-/// either end, extrapolated). Throws std::invalid_argument for fewer than two poses or unsorted stamps.
+/// T_map_mapping at time t by pipeline::poseOnTrajectory (the rule the pipeline's deskew stage uses too:
+/// lerp/slerp, the nearest two extrapolated outside). Throws std::invalid_argument for fewer than two poses
+/// or unsorted stamps.
 Pose mappingPoseAt(const std::vector<pipeline::MappingFrame>& trajectory, TimeNs t);
 
 /// `raw` (calibration-lidar frame, each point at its own time) expressed in the calibration-lidar frame

@@ -91,10 +91,4 @@ std::string validateDataset(const pipeline::CalibrationDataset& dataset, const c
 LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
                                      const registration::Deadline& deadline, const LidarLidarOptions& options = {});
 
-/// Several calibration lidars sharing params.calibration_deadline_s from now (see CalibrationBudget).
-std::vector<LidarLidarResult> calibrateLidarsLidar(const std::vector<pipeline::CalibrationDataset>& datasets,
-                                                   const config::Parameters& params,
-                                                   const registration::CancelToken* cancel = nullptr,
-                                                   const LidarLidarOptions& options = {});
-
 }  // namespace rigcal::calib

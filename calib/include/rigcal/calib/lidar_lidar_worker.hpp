@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_budget.hpp"
 #include "rigcal/calib/lidar_lidar_calibration.hpp"
 
 namespace rigcal::calib {

@@ -19,7 +19,6 @@ struct Parameters {
   double mapper_resolution = 5.0;
   double mapper_step_size = 0.1;
   int mapper_max_iterations = 35;
-  double mapper_epsilon = 0.01;
   int mapper_num_threads = 2;  // upstream 8; a 2-core target is the norm here
   double mapper_max_correspondence_distance = 0.1;
   double leaf_size_input = 0.1;
@@ -44,11 +43,9 @@ struct Parameters {
   double lost_frame_max_angle_diff = 25.0;
   double lost_frame_interpolation_error = 0.05;
   double lost_frame_max_acceleration = 8.0;
-  double viz_max_range = 80.0;
   bool crop_z_calibration_pointclouds = true;
   double crop_z_calibration_pointclouds_value = 2.0;
   bool calibration_use_only_stopped = false;
-  bool calibration_use_only_last_frames = false;
   double max_calibration_range = 80.0;
   double min_calibration_range = 1.5;
   double calibration_min_pca_eigenvalue = 0.25;

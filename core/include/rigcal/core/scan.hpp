@@ -33,6 +33,8 @@ struct Scan {
   [[nodiscard]] std::size_t size() const { return x.size(); }
   [[nodiscard]] bool empty() const { return x.empty(); }
   [[nodiscard]] TimeNs pointTime(std::size_t i) const { return stamp_ns + offset_ns[i]; }
+  /// Time of the latest point (stamp_ns for an empty scan): points need not be in time order.
+  [[nodiscard]] TimeNs endTime() const;
 
   void reserve(std::size_t n);
   /// Every array to n points (new points zeroed); within capacity it never allocates.

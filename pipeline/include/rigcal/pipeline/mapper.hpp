@@ -1,9 +1,11 @@
 #pragma once
-// The mapping lidar's mapper: deskews each scan with constant velocity from the last poses, registers it
-// against the local map (our GICP or NDT, per mapping_registrator), re-deskews it with the registered
-// motion, and classifies the frame by the upstream rules (FrameTracker). A registration that fails its
-// convergence or fitness check makes the frame lost (pose = the prediction) and the map is not fed from
-// it. The local map holds the last local_map_num_keyframes keyframes, restarting at a lost keyframe.
+// The mapping lidar's mapper. Each scan: crop to the mapping range → deskew with the motion model
+// (constant velocity from the last poses, motion_model.hpp) → voxelise → register against the local map
+// (our GICP or NDT, per mapping_registrator; local_map.hpp) from the model's guess → re-deskew with the
+// registered motion → classify the frame by the upstream rules (FrameTracker) → update the model and the
+// map. A registration that fails its convergence or fitness check makes the frame lost (pose = the
+// prediction) and the map is not fed from it. The local map holds the last local_map_num_keyframes
+// keyframes, restarting at a lost keyframe; only a whole sweep seeds it (seed_sweep_check.hpp).
 // Single-threaded: the mapper stage owns it.
 #include <cstdint>
 #include <memory>
@@ -51,7 +53,8 @@ class Mapper {
   Mapper(const Mapper&) = delete;
   Mapper& operator=(const Mapper&) = delete;
 
-  MapperOutput process(const Scan& scan);
+  /// `scan` as decoded (cropRange to mapping_min/max_range is the mapper's first step).
+  MapperOutput process(Scan scan);
   /// With `defer`, process() stops once the pose is known: the stored frame's dense cloud (voxelised from
   /// `deskewed`) and feeding a keyframe to the local map (milliseconds) are left to finishFrame(), which
   /// the caller runs after publishing the pose (the next process() runs it if the caller did not).

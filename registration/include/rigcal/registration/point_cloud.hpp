@@ -36,6 +36,10 @@ PointCloud fromScan(const Scan& scan, std::size_t* dropped = nullptr);
 PointCloud fromTable(const PointTable& table, std::size_t* dropped = nullptr);
 PointCloud fromPoints(std::span<const Eigen::Vector3d> points, std::size_t* dropped = nullptr);
 
+/// The way back: a scan of the cloud's positions (as float) with `like`'s sensor_id, sequence and stamp_ns;
+/// every other field zero (all points at the stamp).
+Scan toScan(const PointCloud& cloud, const Scan& like);
+
 /// A copy with positions, normals and covariances mapped by T_to_from.
 PointCloud transformed(const PointCloud& cloud, const Pose& T_to_from);
 

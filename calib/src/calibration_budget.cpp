@@ -1,4 +1,4 @@
-#include "rigcal/calib/calibration_scheduler.hpp"
+#include "rigcal/calib/calibration_budget.hpp"
 
 #include <algorithm>
 #include <cmath>
