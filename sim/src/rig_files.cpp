@@ -7,6 +7,7 @@
 
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/random.hpp"
+#include "rigcal/core/atomic_file.hpp"
 #include "encoders/ouster_identity.hpp"
 #include "text_format.hpp"
 
@@ -27,10 +28,7 @@ Pose perturb(const Pose& T, double translation, double angle, Rng& rng) {
 }
 
 void writeFile(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error(file.string() + ": cannot write the file");
+  writeFileAtomically(file, [&](std::ostream& out) { out << text; });
 }
 
 std::string velodyneYaml(const LidarModel& m) {

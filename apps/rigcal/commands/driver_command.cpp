@@ -5,6 +5,7 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../rig_loading.hpp"
 #include "../stop_signals.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/core/cpu_latency_request.hpp"
@@ -35,14 +36,15 @@ double parseRate(const std::string& text) {
 void run(const DriverOptions& o) {
   config::RigConfig rig;
   config::SensorConfig sensor;
+  rig = loadRig(o.config);
   try {
-    rig = config::loadRigConfig(o.config);
     sensor = rig.sensor(o.sensor);
   } catch (const config::ConfigError& e) {
     throw CommandFailed(kExitConfig, e.what());
   }
   pipeline::DriverInput input;
   if (!o.live) {
+    requireInputFile(o.pcap, "capture");
     input.pcap = o.pcap;
     input.rate = parseRate(o.rate);
   }
@@ -89,10 +91,10 @@ void run(const DriverOptions& o) {
 void addDriverCommand(CLI::App& app) {
   auto o = std::make_shared<DriverOptions>();
   auto* cmd = app.add_subcommand("driver", "Run one sensor's driver, writing scans into its shared-memory ring");
-  cmd->add_option("--config", o->config, "Rig YAML file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--config", o->config, "Rig YAML file")->required();
   cmd->add_option("--sensor", o->sensor, "Sensor name in the rig file")->required();
   auto* live = cmd->add_flag("--live", o->live, "Read the sensor's UDP port");
-  auto* pcap = cmd->add_option("--pcap", o->pcap, "Read a capture instead")->check(CLI::ExistingFile);
+  auto* pcap = cmd->add_option("--pcap", o->pcap, "Read a capture instead");
   live->excludes(pcap);
   cmd->add_option("--rate", o->rate, "With --pcap: 1.0 = recorded timing, 2 = twice as fast, max = no pacing")
       ->needs(pcap);

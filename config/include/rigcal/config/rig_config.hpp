@@ -16,6 +16,12 @@
 
 namespace rigcal::config {
 
+/// Bounds on what a rig file may ask for (a mistake or a hostile file fails at once, clearly).
+inline constexpr std::uintmax_t kMaxRigFileBytes = 1 << 20;          // a real rig file is a few kB
+inline constexpr std::size_t kMaxSensors = 64;
+inline constexpr std::size_t kMaxSensorNameLength = 64;             // names are [A-Za-z0-9_.-]+
+inline constexpr std::uintmax_t kMaxReferencedFileBytes = 16 << 20;  // calibration / metadata files
+
 /// Where a sensor's packets come from: a live UDP port, or the same port/address filter in a pcap.
 struct SensorSource {
   std::uint16_t port = 0;
