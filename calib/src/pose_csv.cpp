@@ -99,12 +99,12 @@ PoseCsv parsePoseCsv(std::istream& in, const std::string& name, const PoseCsvOpt
     const Eigen::Vector3d position(v[1], v[2], v[3]);
     if (!positions.empty()) {
       const double dt_s = double(stamp - out.stamps.back()) * 1e-9;
-      const double speed = (position - positions.back()).norm() / dt_s;
-      if (!(speed <= options.max_speed_mps)) {
+      const double jump = (position - positions.back()).norm();
+      if (!(jump <= options.max_speed_mps * dt_s + options.jump_allowance_m)) {
         std::ostringstream what;
-        what << "position jumps " << (position - positions.back()).norm() << " m in " << dt_s
-             << " s since line " << line_of_pose.back() << " (" << speed << " m/s; the limit is "
-             << options.max_speed_mps << " m/s)";
+        what << "position jumps " << jump << " m in " << dt_s << " s since line " << line_of_pose.back()
+             << " (" << jump / dt_s << " m/s; the limit is " << options.max_speed_mps << " m/s plus "
+             << options.jump_allowance_m << " m)";
         failLine(name, line_no, what.str());
       }
     }

@@ -1,7 +1,9 @@
 // `rigcal driver --config RIG --sensor NAME (--live | --pcap F [--rate R])`: one sensor's driver in its
 // own process, writing every finished scan into the shared-memory ring /rigcal.<sensor>.
+#include <iomanip>
 #include <iostream>
 #include <optional>
+#include <sstream>
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
@@ -11,6 +13,7 @@
 #include "rigcal/core/cpu_latency_request.hpp"
 #include "rigcal/pipeline/sensor_driver.hpp"
 #include "rigcal/shm/ring_error.hpp"
+#include "rigcal/shm/ring_layout.hpp"
 #include "rigcal/shm/scan_ring_writer.hpp"
 
 namespace rigcal::app {
@@ -31,6 +34,26 @@ double parseRate(const std::string& text) {
   } catch (const std::exception&) {
   }
   throw CommandFailed(kExitUsage, "--rate must be a positive number or 'max', got '" + text + "'");
+}
+
+// The ring is allocated in full up front (every slot holds the sensor's largest scan): bound it in bytes.
+constexpr std::uint64_t kMaxRingBytes = std::uint64_t(512) << 20;
+
+std::string mebibytes(std::uint64_t bytes) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(1) << double(bytes) / double(1 << 20);
+  return o.str();
+}
+
+void checkRingSize(unsigned slots, std::uint32_t max_points) {
+  const std::uint64_t bytes = shm::ringBytes(slots, max_points);
+  if (bytes <= kMaxRingBytes) return;
+  unsigned fits = slots;
+  while (fits > shm::kMinSlots && shm::ringBytes(fits, max_points) > kMaxRingBytes) --fits;
+  throw CommandFailed(kExitUsage, "--slots " + std::to_string(slots) + ": the ring would take " + mebibytes(bytes) +
+                                      " MiB (" + std::to_string(max_points) + " points per slot); the limit is " +
+                                      mebibytes(kMaxRingBytes) + " MiB, at most " + std::to_string(fits) +
+                                      " slots for this sensor");
 }
 
 void run(const DriverOptions& o) {
@@ -66,14 +89,19 @@ void run(const DriverOptions& o) {
     w.sensor = sensor.name;
     w.max_points = std::uint32_t(driver->maxPointsPerScan());
     w.slot_count = o.slots;
+    checkRingSize(o.slots, w.max_points);
     if (!o.shm_prefix.empty()) w.name_prefix = o.shm_prefix;
     ring = std::make_unique<shm::ScanRingWriter>(w);
   } catch (const shm::RingError& e) {
     throw CommandFailed(kExitFailure, e.what());
+  } catch (const CommandFailed&) {
+    throw;
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());
   }
-  std::cout << "driver '" << sensor.name << "' (" << sensor.model << ") writing " << ring->segmentName()
+  std::cout << "driver '" << sensor.name << "' (" << sensor.model << ") writing " << ring->segmentName() << " ("
+            << o.slots << " slots, " << mebibytes(shm::ringBytes(o.slots, std::uint32_t(driver->maxPointsPerScan())))
+            << " MiB)"
             << (ring->tookOver() ? " (took over a stale ring)" : "") << std::endl;
 
   driver->run([&] { ring->heartbeat(); });
