@@ -166,13 +166,14 @@ SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
 
   const YAML::Node src = r.required(n, "source", "sensor '" + s.name + "'");
   r.requireMap(src, "source");
-  r.checkKeys(src, {"port", "address", "multicast_group"}, "source of sensor '" + s.name + "'");
+  r.checkKeys(src, {"port", "address", "multicast_group", "bind"}, "source of sensor '" + s.name + "'");
   const YAML::Node port = r.required(src, "port", "source of sensor '" + s.name + "'");
   const long long p = r.integer(port, "port");
   r.inRange(port, "port", double(p), 1, 65535);
   s.source.port = std::uint16_t(p);
   if (src["address"]) s.source.address = r.ipv4(src["address"], "address");
   if (src["multicast_group"]) s.source.multicast_group = r.ipv4(src["multicast_group"], "multicast_group", true);
+  if (src["bind"]) s.source.bind = r.ipv4(src["bind"], "bind");
 
   if (n["calibration"]) s.calibration = r.existingFile(n["calibration"], "calibration");
   if (n["metadata"]) s.metadata = r.existingFile(n["metadata"], "metadata");
@@ -285,11 +286,14 @@ void checkDistinctSources(const Reader& r, const YAML::Node& nodes, const std::v
   for (std::size_t j = 0; j < sensors.size(); ++j)
     for (std::size_t i = 0; i < j; ++i) {
       const SensorSource &a = sensors[i].source, &b = sensors[j].source;
-      if (a.port != b.port || (a.address && b.address && *a.address != *b.address)) continue;
+      // On a loopback bind the address filter is off: then only the port tells sensors apart.
+      const bool filtered = !a.bindsLoopback() && !b.bindsLoopback();
+      if (a.port != b.port || (filtered && a.address && b.address && *a.address != *b.address)) continue;
       r.fail(nodes[j], "sensors '" + sensors[i].name + "' and '" + sensors[j].name + "' both receive on port " +
                            std::to_string(a.port) +
-                           (a.address && b.address ? " from the same address " + *a.address
-                                                   : std::string(" without distinct source addresses")) +
+                           (!filtered ? std::string(" on a loopback bind (no address filter)")
+                            : a.address && b.address ? " from the same address " + *a.address
+                                                     : std::string(" without distinct source addresses")) +
                            ": give each its own port or its own 'address'");
     }
 }

@@ -111,6 +111,12 @@ void run(const DriverOptions& o) {
             << " too large for a slot; " << a.packets << " packets, " << a.malformed << " malformed, "
             << a.lost_packets << " lost" << std::endl;
   if (!driver->warning().empty()) std::cerr << "warning: " << driver->warning() << '\n';
+  if (const auto& s = driver->sourceStats(); o.live && s.filtered > 0)
+    std::cerr << "warning: " << s.filtered << " datagrams on port " << sensor.source.port
+              << " dropped by the source-address filter (sensor address " << sensor.source.address.value_or("?")
+              << "), the last from " << drivers::formatIpv4(s.last_filtered.address) << ':' << s.last_filtered.port
+              << (s.last_filtered.address >> 24 == 127 ? "; a replay on this host? give the sensor 'bind: 127.0.0.1'" : "")
+              << '\n';
   if (StopSignals::requested() && !o.live) throw CommandFailed(kExitInterrupted, "driver interrupted");
 }
 

@@ -27,6 +27,11 @@ struct SensorSource {
   std::uint16_t port = 0;
   std::optional<std::string> address;          // the sensor's IPv4 address (source filter)
   std::optional<std::string> multicast_group;  // live only: join this group
+  /// Live only: the local IPv4 address to receive on (default any, 0.0.0.0). A loopback address
+  /// (127.0.0.0/8) receives from this host alone, e.g. `rigcal replay --to 127.0.0.1`: the `address`
+  /// filter is then not applied (replayed datagrams come from 127.0.0.1, not from the sensor).
+  std::optional<std::string> bind;
+  [[nodiscard]] bool bindsLoopback() const { return bind && bind->rfind("127.", 0) == 0; }
 };
 
 struct SensorConfig {
