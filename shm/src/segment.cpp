@@ -92,11 +92,11 @@ void Segment::requireOwnedPrivately() const {
     throw RingError(RingError::Kind::kForeign, where + "belongs to uid " + std::to_string(st.st_uid) + ", not uid " +
                                                    std::to_string(::geteuid()) +
                                                    ": refusing a ring another user created (remove it if it is stale)");
-  if ((st.st_mode & 0077) != 0) {
+  if ((st.st_mode & 0022) != 0) {  // others may write or truncate it (reading leaks only scans)
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", unsigned(st.st_mode & 07777));
     throw RingError(RingError::Kind::kForeign, where + "has mode " + mode +
-                                                   ": other users could read or change it; refusing it (remove it)");
+                                                   ": other users could change or truncate it; refusing it (remove it)");
   }
 }
 

@@ -35,7 +35,7 @@ class Segment {
   /// flock(LOCK_EX | LOCK_NB): true if this process now holds the writer lock. The kernel drops it when
   /// the descriptor closes — including when the process is killed — which is what makes takeover safe.
   bool tryLockExclusive();
-  /// Refuses (RingError kForeign) a segment this user does not own or that other users may open:
+  /// Refuses (RingError kForeign) a segment this user does not own or that other users may write:
   /// another local user could otherwise pre-create the ring, then read, overwrite or truncate it.
   void requireOwnedPrivately() const;
   /// True while /dev/shm/<name> is this very segment (same device and inode).
