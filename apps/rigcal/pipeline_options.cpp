@@ -6,12 +6,14 @@
 
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "rig_loading.hpp"
+#include "rigcal/core/atomic_file.hpp"
 #include "rigcal/pipeline/stage_thread.hpp"
 
 namespace rigcal::app {
 
 void addPipelineOptions(CLI::App& cmd, PipelineCliOptions& o) {
-  auto* pcap = cmd.add_option("--pcap", o.pcap, "Read the sensors' packets from a capture")->check(CLI::ExistingFile);
+  auto* pcap = cmd.add_option("--pcap", o.pcap, "Read the sensors' packets from a capture");
   auto* live = cmd.add_flag("--live", o.live, "Read the sensors' UDP ports (real time)");
   auto* shm = cmd.add_flag("--shm", o.shm, "Read the shared-memory rings of `rigcal driver` processes (real time)");
   live->excludes(pcap);
@@ -30,6 +32,7 @@ void addPipelineOptions(CLI::App& cmd, PipelineCliOptions& o) {
 pipeline::PipelineOptions toPipelineOptions(const PipelineCliOptions& o) {
   pipeline::PipelineOptions p;
   if (!o.pcap.empty()) {
+    requireInputFile(o.pcap, "capture");  // exit 4, as every command's missing input
     p.input = pipeline::InputKind::kPcap;
     p.pcap = o.pcap;
     if (!o.rate.empty()) {
@@ -68,9 +71,11 @@ pipeline::PipelineOptions toPipelineOptions(const PipelineCliOptions& o) {
 void reportStats(const PipelineCliOptions& o, const pipeline::PipelineStats& stats) {
   std::cout << stats.table();
   if (o.stats_file.empty()) return;
-  std::ofstream out(o.stats_file);
-  out << stats.json() << '\n';
-  if (!out) throw CommandFailed(kExitFailure, "cannot write --stats file " + o.stats_file);
+  try {
+    writeFileAtomically(o.stats_file, [&](std::ostream& out) { out << stats.json() << '\n'; });
+  } catch (const std::runtime_error& e) {
+    throw CommandFailed(kExitFailure, std::string("--stats: ") + e.what());
+  }
 }
 
 }  // namespace rigcal::app

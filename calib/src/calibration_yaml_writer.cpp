@@ -1,4 +1,5 @@
 #include "rigcal/calib/calibration_yaml_writer.hpp"
+#include "rigcal/core/atomic_file.hpp"
 
 #include <fstream>
 #include <iomanip>
@@ -72,10 +73,7 @@ std::string calibrationYaml(const CalibrationOutcome& o) {
 }
 
 void writeCalibrationYaml(const std::filesystem::path& path, const CalibrationOutcome& outcome) {
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error(path.string() + ": cannot open for writing");
-  file << calibrationYaml(outcome);
-  if (!file) throw std::runtime_error(path.string() + ": write failed");
+  writeFileAtomically(path, [&](std::ostream& out) { out << calibrationYaml(outcome); });
 }
 
 }  // namespace rigcal::calib

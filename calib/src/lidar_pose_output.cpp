@@ -10,15 +10,13 @@
 
 #include "rigcal/core/ply_io.hpp"
 #include "rigcal/core/point_table.hpp"
+#include "rigcal/core/atomic_file.hpp"
 
 namespace rigcal::calib {
 namespace {
 
 void writeText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
-  out << text;
-  if (!out.flush()) throw std::runtime_error(path.string() + ": write failed");
+  writeFileAtomically(path, [&](std::ostream& out) { out << text; });
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "rigcal/calib/cloud_writers.hpp"
+#include "rigcal/core/atomic_file.hpp"
 
 namespace rigcal::calib {
 namespace {
@@ -215,17 +216,23 @@ RgbImage renderOverview(const CalibrationOutcome& o, int panel_size) {
   return img;
 }
 
+namespace {
+// libpng writes through these into the atomic file's stream (which records any write error).
+void pngWrite(png_structp png, png_bytep data, std::size_t size) {
+  static_cast<std::ostream*>(png_get_io_ptr(png))->write(reinterpret_cast<const char*>(data), std::streamsize(size));
+}
+void pngFlush(png_structp) {}
+}  // namespace
+
 void writePng(const std::filesystem::path& path, const RgbImage& image) {
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) throw std::runtime_error(path.string() + ": cannot open for writing");
+  AtomicFile file(path);
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr || setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
-    std::fclose(file);
     throw std::runtime_error(path.string() + ": PNG encoding failed");
   }
-  png_init_io(png, file);
+  png_set_write_fn(png, &file.stream(), pngWrite, pngFlush);
   png_set_IHDR(png, info, png_uint_32(image.width), png_uint_32(image.height), 8, PNG_COLOR_TYPE_RGB,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
@@ -233,7 +240,7 @@ void writePng(const std::filesystem::path& path, const RgbImage& image) {
     png_write_row(png, image.rgb.data() + std::size_t(y) * std::size_t(image.width) * 3);
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  if (std::fclose(file) != 0) throw std::runtime_error(path.string() + ": write failed");
+  file.commit();
 }
 
 void writeOverviewPng(const std::filesystem::path& path, const CalibrationOutcome& outcome, int panel_size) {

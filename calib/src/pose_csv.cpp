@@ -77,6 +77,12 @@ PoseCsv parsePoseCsv(std::istream& in, const std::string& name, const PoseCsvOpt
       if (!parseNumber(cells[c], v[c - 1]) || !std::isfinite(v[c - 1]))
         failLine(name, line_no, describeCell(c, cells[c]) + " is not a finite number");
     }
+    for (std::size_t c = 2; c <= 4; ++c)
+      if (std::abs(v[c - 1]) > options.max_abs_position_m) {
+        std::ostringstream what;
+        what << describeCell(c, cells[c]) << " is beyond " << options.max_abs_position_m << " m";
+        failLine(name, line_no, what.str());
+      }
     Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
     const double norm = q.norm();
     if (std::abs(norm - 1.0) > options.quaternion_norm_tolerance) {
@@ -90,9 +96,21 @@ PoseCsv parsePoseCsv(std::istream& in, const std::string& name, const PoseCsvOpt
                "timestamp " + std::to_string(stamp) + " is not after the previous pose's " +
                    std::to_string(out.stamps.back()) + " (line " +
                    std::to_string(line_of_pose.back()) + ")");
+    const Eigen::Vector3d position(v[1], v[2], v[3]);
+    if (!positions.empty()) {
+      const double dt_s = double(stamp - out.stamps.back()) * 1e-9;
+      const double jump = (position - positions.back()).norm();
+      if (!(jump <= options.max_speed_mps * dt_s + options.jump_allowance_m)) {
+        std::ostringstream what;
+        what << "position jumps " << jump << " m in " << dt_s << " s since line " << line_of_pose.back()
+             << " (" << jump / dt_s << " m/s; the limit is " << options.max_speed_mps << " m/s plus "
+             << options.jump_allowance_m << " m)";
+        failLine(name, line_no, what.str());
+      }
+    }
     out.stamps.push_back(stamp);
     line_of_pose.push_back(line_no);
-    positions.emplace_back(v[1], v[2], v[3]);
+    positions.push_back(position);
     rotations.push_back(q.normalized());
   }
   if (in.bad()) throw std::runtime_error(name + ": read error");

@@ -1,4 +1,5 @@
 #include "rigcal/calib/report_json_writer.hpp"
+#include "rigcal/core/atomic_file.hpp"
 
 #include <fstream>
 #include <map>
@@ -190,10 +191,7 @@ json reportJson(const CalibrationOutcome& o) {
 }
 
 void writeReportJson(const std::filesystem::path& path, const CalibrationOutcome& outcome) {
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error(path.string() + ": cannot open for writing");
-  file << reportJson(outcome).dump(2) << "\n";
-  if (!file) throw std::runtime_error(path.string() + ": write failed");
+  writeFileAtomically(path, [&](std::ostream& out) { out << reportJson(outcome).dump(2) << "\n"; });
 }
 
 }  // namespace rigcal::calib

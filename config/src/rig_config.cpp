@@ -1,8 +1,12 @@
 #include "rigcal/config/rig_config.hpp"
 
+#include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <fstream>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -90,14 +94,48 @@ class Reader {
     }
   }
 
-  /// A file the config refers to: resolved against the config's folder, and it must exist.
+  /// A file the config refers to: resolved against the config's folder; it must be a readable regular
+  /// file no larger than kMaxReferencedFileBytes (not a folder, a device, a pipe).
   std::filesystem::path existingFile(const YAML::Node& n, const std::string& key) const {
     std::filesystem::path p = text(n, key);
     if (p.is_relative()) p = file_.parent_path() / p;
     p = p.lexically_normal();
-    if (!std::filesystem::is_regular_file(p))
-      fail(n, key + " file '" + n.as<std::string>() + "' not found (looked for " + p.string() + ")");
+    const std::string named = key + " file '" + n.as<std::string>() + "'";
+    std::error_code ec;
+    const auto status = std::filesystem::status(p, ec);
+    if (!std::filesystem::exists(status))
+      fail(n, named + " not found (looked for " + p.string() + ")");
+    if (!std::filesystem::is_regular_file(status))
+      fail(n, named + " is not a regular file (" + p.string() + ")");
+    if (const auto size = std::filesystem::file_size(p, ec); !ec && size > kMaxReferencedFileBytes)
+      fail(n, named + " is " + std::to_string(size) + " bytes; the limit is " +
+                  std::to_string(kMaxReferencedFileBytes) + " (" + p.string() + ")");
+    if (!std::ifstream(p, std::ios::binary)) fail(n, named + " is not readable (" + p.string() + ")");
     return p;
+  }
+
+  /// An IPv4 address in dotted form; `multicast` also requires 224.0.0.0/4.
+  std::string ipv4(const YAML::Node& n, const std::string& key, bool multicast = false) const {
+    const std::string v = text(n, key);
+    in_addr a{};
+    if (inet_pton(AF_INET, v.c_str(), &a) != 1) fail(n, "'" + key + "' = '" + v + "' is not an IPv4 address");
+    if (multicast && (ntohl(a.s_addr) >> 28) != 0xE)
+      fail(n, "'" + key + "' = '" + v + "' is not a multicast address (224.0.0.0 to 239.255.255.255)");
+    return v;
+  }
+
+  /// Refuses a mapping that names the same key twice (yaml-cpp would keep one silently), anywhere.
+  void checkDuplicateKeys(const YAML::Node& node) const {
+    if (node.IsSequence()) {
+      for (const auto& child : node) checkDuplicateKeys(child);
+    } else if (node.IsMap()) {
+      std::set<std::string> seen;
+      for (const auto& kv : node) {
+        if (kv.first.IsScalar() && !seen.insert(kv.first.Scalar()).second)
+          fail(kv.first, "key '" + kv.first.Scalar() + "' appears twice in the same mapping");
+        checkDuplicateKeys(kv.second);
+      }
+    }
   }
 
  private:
@@ -114,18 +152,28 @@ SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
               "sensor");
   SensorConfig s;
   s.where = r.at(n);
-  s.name = r.text(r.required(n, "name", "a sensor"), "name");
+  const YAML::Node name = r.required(n, "name", "a sensor");
+  s.name = r.text(name, "name");
+  // The name becomes output file names (<name>_after.pcd) and ring names: no path, no surprises.
+  const bool plain = !s.name.empty() && s.name.size() <= kMaxSensorNameLength && s.name != "." && s.name != ".." &&
+                     std::all_of(s.name.begin(), s.name.end(), [](char c) {
+                       return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '.' || c == '-';
+                     });
+  if (!plain)
+    r.fail(name, "sensor name '" + s.name + "' is not allowed; use 1 to " + std::to_string(kMaxSensorNameLength) +
+                     " letters, digits, '_', '.', '-' (not '.' or '..')");
   s.model = r.text(r.required(n, "model", "sensor '" + s.name + "'"), "model");
 
   const YAML::Node src = r.required(n, "source", "sensor '" + s.name + "'");
   r.requireMap(src, "source");
-  r.checkKeys(src, {"port", "address", "multicast_group"}, "source of sensor '" + s.name + "'");
+  r.checkKeys(src, {"port", "address", "multicast_group", "bind"}, "source of sensor '" + s.name + "'");
   const YAML::Node port = r.required(src, "port", "source of sensor '" + s.name + "'");
   const long long p = r.integer(port, "port");
   r.inRange(port, "port", double(p), 1, 65535);
   s.source.port = std::uint16_t(p);
-  if (src["address"]) s.source.address = r.text(src["address"], "address");
-  if (src["multicast_group"]) s.source.multicast_group = r.text(src["multicast_group"], "multicast_group");
+  if (src["address"]) s.source.address = r.ipv4(src["address"], "address");
+  if (src["multicast_group"]) s.source.multicast_group = r.ipv4(src["multicast_group"], "multicast_group", true);
+  if (src["bind"]) s.source.bind = r.ipv4(src["bind"], "bind");
 
   if (n["calibration"]) s.calibration = r.existingFile(n["calibration"], "calibration");
   if (n["metadata"]) s.metadata = r.existingFile(n["metadata"], "metadata");
@@ -232,6 +280,24 @@ void readParameters(const Reader& r, const YAML::Node& n, Parameters& params,
   }
 }
 
+/// Two sensors on one port must be told apart by their source addresses: otherwise one driver would
+/// take both streams (and calibrate a mixture).
+void checkDistinctSources(const Reader& r, const YAML::Node& nodes, const std::vector<SensorConfig>& sensors) {
+  for (std::size_t j = 0; j < sensors.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i) {
+      const SensorSource &a = sensors[i].source, &b = sensors[j].source;
+      // On a loopback bind the address filter is off: then only the port tells sensors apart.
+      const bool filtered = !a.bindsLoopback() && !b.bindsLoopback();
+      if (a.port != b.port || (filtered && a.address && b.address && *a.address != *b.address)) continue;
+      r.fail(nodes[j], "sensors '" + sensors[i].name + "' and '" + sensors[j].name + "' both receive on port " +
+                           std::to_string(a.port) +
+                           (!filtered ? std::string(" on a loopback bind (no address filter)")
+                            : a.address && b.address ? " from the same address " + *a.address
+                                                     : std::string(" without distinct source addresses")) +
+                           ": give each its own port or its own 'address'");
+    }
+}
+
 void checkConsistency(const Reader& r, const YAML::Node& root, const RigConfig& rig) {
   const Parameters& p = rig.parameters;
   const YAML::Node params = root["parameters"] ? root["parameters"] : root;
@@ -260,6 +326,11 @@ namespace {
 
 RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file)) throw ConfigError({file}, "rig file not found");
+  // Checked before parsing: a huge file would take gigabytes and a minute before any other error.
+  std::error_code ec;
+  if (const auto size = std::filesystem::file_size(file, ec); !ec && size > kMaxRigFileBytes)
+    throw ConfigError({file}, "rig file is " + std::to_string(size) + " bytes; the limit is " +
+                                  std::to_string(kMaxRigFileBytes));
   const Reader r(file);
   YAML::Node root;
   try {
@@ -268,6 +339,7 @@ RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
     throw ConfigError({file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + e.msg);
   }
   r.requireMap(root, "a rig file");
+  r.checkDuplicateKeys(root);
   r.checkKeys(root, {"rig", "sensors", "roles", "initial_extrinsics", "vehicle", "parameters"}, "the rig file");
 
   RigConfig rig;
@@ -276,12 +348,16 @@ RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
 
   const YAML::Node sensors = r.required(root, "sensors", "the rig file");
   if (!sensors.IsSequence() || sensors.size() == 0) r.fail(sensors, "'sensors' must be a non-empty list");
+  if (sensors.size() > kMaxSensors)
+    r.fail(sensors, "'sensors' lists " + std::to_string(sensors.size()) + " sensors; the limit is " +
+                        std::to_string(kMaxSensors));
   std::set<std::string> names;
   for (const auto& n : sensors) {
     SensorConfig s = readSensor(r, n);
     if (!names.insert(s.name).second) r.fail(n, "sensor name '" + s.name + "' is used twice");
     rig.sensors.push_back(std::move(s));
   }
+  checkDistinctSources(r, sensors, rig.sensors);
   const std::vector<std::string> sensor_names(names.begin(), names.end());
   const auto requireSensor = [&](const YAML::Node& n, const std::string& name) {
     if (names.count(name)) return;

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rigcal/core/atomic_file.hpp"
 #include "rigcal/core/lzf.hpp"
 #include "table_rows.hpp"
 
@@ -176,8 +177,8 @@ PointTable readPcd(const std::filesystem::path& path) {
 }
 
 void writePcd(const std::filesystem::path& path, const PointTable& table, PcdEncoding encoding) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) failFile(path, "cannot create");
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
   const auto& fields = table.fields();
   out << "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS";
   for (const auto& f : fields) out << ' ' << f.name;
@@ -194,7 +195,7 @@ void writePcd(const std::filesystem::path& path, const PointTable& table, PcdEnc
     detail::writeAsciiRows(out, table);
   else
     detail::writeBinaryRows(out, table);
-  if (!out) failFile(path, "write failed");
+  file.commit();
 }
 
 }  // namespace rigcal

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rigcal/core/atomic_file.hpp"
 #include "table_rows.hpp"
 
 namespace rigcal {
@@ -100,8 +101,8 @@ PointTable readPly(const std::filesystem::path& path) {
 }
 
 void writePly(const std::filesystem::path& path, const PointTable& table, PlyEncoding encoding) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) failFile(path, "cannot create");
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
   const auto& fields = table.fields();
   out << "ply\nformat "
       << (encoding == PlyEncoding::kAscii ? "ascii" : "binary_little_endian") << " 1.0\n"
@@ -113,7 +114,7 @@ void writePly(const std::filesystem::path& path, const PointTable& table, PlyEnc
     detail::writeAsciiRows(out, table);
   else
     detail::writeBinaryRows(out, table);
-  if (!out) failFile(path, "write failed");
+  file.commit();
 }
 
 }  // namespace rigcal

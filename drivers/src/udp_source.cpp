@@ -255,6 +255,7 @@ std::optional<UdpPacket> UdpSource::next() {
       // The destination port is the socket's own: only the source-address filter applies.
       if (config_.filter.source_address && packet.source.address != *config_.filter.source_address) {
         ++stats_.filtered;
+        stats_.last_filtered = packet.source;
         continue;
       }
       ++stats_.packets;

@@ -20,10 +20,12 @@ drivers::DecoderConfig decoderConfigFor(const config::SensorConfig& sensor) {
 }
 
 namespace {
-drivers::PacketFilter filterFor(const config::SensorConfig& sensor) {
+drivers::PacketFilter filterFor(const config::SensorConfig& sensor, bool live) {
   drivers::PacketFilter f;
   f.destination_port = sensor.source.port;
-  if (sensor.source.address) f.source_address = drivers::parseIpv4(*sensor.source.address);
+  // Bound to loopback, only this host can send (a replay, from 127.0.0.1): the sensor's address cannot match.
+  if (sensor.source.address && !(live && sensor.source.bindsLoopback()))
+    f.source_address = drivers::parseIpv4(*sensor.source.address);
   return f;
 }
 constexpr std::size_t kMaxLags = 4096;  // sweeps kept for the clock-lag median (7 min at 10 Hz)
@@ -59,12 +61,13 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
   try {
     decoder_ = drivers::makeDecoder(decoderConfigFor(sensor));
     if (input.pcap) {
-      raw_source_ = std::make_unique<drivers::PcapSource>(*input.pcap, filterFor(sensor));
+      raw_source_ = std::make_unique<drivers::PcapSource>(*input.pcap, filterFor(sensor, false));
       source_ = std::make_unique<drivers::PacedSource>(*raw_source_, input.rate, stop_);
     } else {
       drivers::UdpSourceConfig udp;
       udp.port = sensor.source.port;
-      udp.filter = filterFor(sensor);
+      udp.filter = filterFor(sensor, true);
+      if (sensor.source.bind) udp.bind_address = *sensor.source.bind;
       if (sensor.source.multicast_group) udp.multicast_group = *sensor.source.multicast_group;
       source_ = std::make_unique<drivers::UdpSource>(udp);
     }

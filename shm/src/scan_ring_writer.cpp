@@ -70,6 +70,7 @@ void ScanRingWriter::Impl::openSegment() {
     // The lock, not the header, decides ownership: the kernel releases it when its holder dies.
     if (!seg->tryLockExclusive()) throw RingError(RingError::Kind::kLiveWriter, liveWriterMessage(*seg));
     if (!seg->isStillNamed()) continue;  // another writer replaced it while we were locking
+    if (!created) seg->requireOwnedPrivately();  // never adopt a ring another user could touch
     if (created || seg->size() == 0) {
       seg->truncate(bytes);
       seg->map(true);

@@ -4,7 +4,10 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 
+#include <unistd.h>
+
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 #include "rigcal/shm/ring_error.hpp"
@@ -28,7 +31,7 @@ std::optional<Segment> Segment::create(const std::string& name) {
   s.writable_ = true;
   try {
     s.shm_ = bip::shared_memory_object(bip::create_only, name.c_str(), bip::read_write,
-                                       bip::permissions(0660));
+                                       bip::permissions(0600));
   } catch (const bip::interprocess_exception& e) {
     if (e.get_error_code() == bip::already_exists_error) return std::nullopt;
     fail("cannot create", name, e.what());
@@ -79,6 +82,22 @@ bool Segment::tryLockExclusive() {
   if (::flock(fd(), LOCK_EX | LOCK_NB) == 0) return true;
   if (errno == EWOULDBLOCK) return false;
   fail("flock", name_, std::strerror(errno));
+}
+
+void Segment::requireOwnedPrivately() const {
+  struct stat st {};
+  if (::fstat(fd(), &st) != 0) fail("fstat", name_, std::strerror(errno));
+  const std::string where = "shared-memory ring '" + name_ + "' (" + segmentPath(name_).string() + ") ";
+  if (st.st_uid != ::geteuid())
+    throw RingError(RingError::Kind::kForeign, where + "belongs to uid " + std::to_string(st.st_uid) + ", not uid " +
+                                                   std::to_string(::geteuid()) +
+                                                   ": refusing a ring another user created (remove it if it is stale)");
+  if ((st.st_mode & 0022) != 0) {  // others may write or truncate it (reading leaks only scans)
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", unsigned(st.st_mode & 07777));
+    throw RingError(RingError::Kind::kForeign, where + "has mode " + mode +
+                                                   ": other users could change or truncate it; refusing it (remove it)");
+  }
 }
 
 bool Segment::isStillNamed() const {

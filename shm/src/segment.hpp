@@ -18,7 +18,7 @@ class Segment {
   Segment(Segment&&) noexcept = default;
   Segment& operator=(Segment&&) noexcept = default;
 
-  /// Creates `name` exclusively, empty, mode 0660; nullopt if a segment of that name already exists.
+  /// Creates `name` exclusively, empty, mode 0600 (only this user); nullopt if one of that name exists.
   static std::optional<Segment> create(const std::string& name);
   /// Opens an existing segment; nullopt if there is none.
   static std::optional<Segment> open(const std::string& name, bool writable);
@@ -35,6 +35,9 @@ class Segment {
   /// flock(LOCK_EX | LOCK_NB): true if this process now holds the writer lock. The kernel drops it when
   /// the descriptor closes — including when the process is killed — which is what makes takeover safe.
   bool tryLockExclusive();
+  /// Refuses (RingError kForeign) a segment this user does not own or that other users may write:
+  /// another local user could otherwise pre-create the ring, then read, overwrite or truncate it.
+  void requireOwnedPrivately() const;
   /// True while /dev/shm/<name> is this very segment (same device and inode).
   [[nodiscard]] bool isStillNamed() const;
 

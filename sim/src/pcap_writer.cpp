@@ -18,11 +18,11 @@ void put32(std::vector<std::uint8_t>& b, std::size_t at, std::uint32_t v) {
   put16(b, at, std::uint16_t(v >> 16));
   put16(b, at + 2, std::uint16_t(v));
 }
-void le32(std::ofstream& out, std::uint32_t v) {  // pcap headers: little-endian
+void le32(std::ostream& out, std::uint32_t v) {  // pcap headers: little-endian
   const char b[4] = {char(v), char(v >> 8), char(v >> 16), char(v >> 24)};
   out.write(b, 4);
 }
-void le16(std::ofstream& out, std::uint16_t v) {
+void le16(std::ostream& out, std::uint16_t v) {
   const char b[2] = {char(v), char(v >> 8)};
   out.write(b, 2);
 }
@@ -67,8 +67,7 @@ TimeNs wireTimeNs(std::size_t bytes) {
 }
 
 PcapWriter::PcapWriter(const std::filesystem::path& file, Options options)
-    : file_(file), options_(options), out_(file, std::ios::binary | std::ios::trunc) {
-  if (!out_) throw std::runtime_error(file.string() + ": cannot create the capture file");
+    : file_(file), options_(options), file_out_(std::make_unique<AtomicFile>(file)), out_(file_out_->stream()) {
   if (options_.mtu < 68 || (options_.mtu - kIpv4Header) % 8 != 0)
     throw std::invalid_argument("pcap writer: the MTU minus the IPv4 header must be a multiple of 8");
   le32(out_, 0xa1b23c4d);  // nanosecond-resolution pcap
@@ -134,10 +133,7 @@ TimeNs PcapWriter::writeDatagram(const NetEndpoint& source, const NetEndpoint& d
 }
 
 void PcapWriter::close() {
-  out_.flush();
-  const bool ok = bool(out_);
-  out_.close();
-  if (!ok) throw std::runtime_error(file_.string() + ": write failed (disk full?)");
+  file_out_->commit();
 }
 
 TimeNs NicClock::stamp(TimeNs send_ns, TimeNs wire_ns) {

@@ -5,6 +5,7 @@
 
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/random.hpp"
+#include "rigcal/core/atomic_file.hpp"
 #include "text_format.hpp"
 
 namespace rigcal::sim {
@@ -24,10 +25,7 @@ std::string poseFlow(const Pose& T) {
 }
 
 void writeFile(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error(file.string() + ": cannot write the file");
+  writeFileAtomically(file, [&](std::ostream& out) { out << text; });
 }
 
 }  // namespace

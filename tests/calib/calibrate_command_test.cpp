@@ -71,13 +71,13 @@ TEST(CalibrateCommand, StatsAndCoresLikeRigcalMap) {
   EXPECT_EQ(both.exit_code, 2) << both.err;
 }
 
-// --pcap is checked with the other pipeline options (as `rigcal map`): a usage error naming the file.
-TEST(CalibrateCommand, MissingPcapIsAUsageErrorNamingTheFile) {
+// A missing --pcap is an input error naming the file (exit 4, as in every command).
+TEST(CalibrateCommand, MissingPcapIsAnInputErrorNamingTheFile) {
   TempDir dir;
   const auto r = runRigcal({"calibrate", "--config", writeRig(dir).string(), "--pcap", (dir / "nope.pcap").string(),
                             "--out", (dir / "out").string()});
-  EXPECT_EQ(r.exit_code, 2) << r.err;
-  EXPECT_NE(r.err.find("nope.pcap"), std::string::npos) << r.err;
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("nope.pcap: capture not found"), std::string::npos) << r.err;
 }
 
 TEST(CalibrateCommand, BadConfigIsAConfigErrorWithItsLocation) {

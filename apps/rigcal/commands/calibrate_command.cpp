@@ -18,6 +18,8 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../rig_loading.hpp"
+#include "../output_folder.hpp"
 #include "../pipeline_options.hpp"
 #include "../stop_signals.hpp"
 #include "rigcal/calib/base_from_motion.hpp"
@@ -63,18 +65,11 @@ std::string progressLine(const pipeline::PipelineProgress& p) {
 
 void run(const CalibrateOptions& o) {
   const auto t_start = Clock::now();
-  config::RigConfig rig;
-  try {
-    rig = config::loadRigConfig(o.config);
-  } catch (const config::ConfigError& e) {
-    throw CommandFailed(kExitConfig, e.what());
-  }
+  config::RigConfig rig = loadRig(o.config);
   if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
   const pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
   const bool realtime = po.mode == pipeline::PipelineMode::kRealtime;
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec) throw CommandFailed(kExitInput, o.out + ": cannot create the output folder (" + ec.message() + ")");
+  prepareOutputFolder(o.out);
 
   StopSignals signals;
   // Every calibration lidar shares one calibration_deadline_s, whenever its dataset comes (budget full
@@ -254,7 +249,7 @@ void run(const CalibrateOptions& o) {
 void addCalibrateCommand(CLI::App& app) {
   auto o = std::make_shared<CalibrateOptions>();
   CLI::App* cmd = app.add_subcommand("calibrate", "Map with the mapping lidar and calibrate the rig (the main job).");
-  cmd->add_option("--config", o->config, "rig YAML file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--config", o->config, "rig YAML file")->required();
   addPipelineOptions(*cmd, o->pipeline);
   cmd->add_option("--out", o->out, "output folder (default rigcal-out)");
   cmd->add_option("--deadline", o->deadline, "seconds for the lidar-lidar calibration (calibration_deadline_s)")

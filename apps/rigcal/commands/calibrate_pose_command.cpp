@@ -12,6 +12,8 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../rig_loading.hpp"
+#include "../output_folder.hpp"
 #include "rigcal/calib/lidar_pose_calibration.hpp"
 #include "rigcal/calib/lidar_pose_output.hpp"
 #include "rigcal/calib/pose_csv.hpp"
@@ -47,12 +49,6 @@ std::string cat(const Parts&... parts) {
   return o.str();
 }
 
-void requireFile(const std::string& path, const char* what) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw CommandFailed(kExitInput, cat(path, ": ", what, fs::exists(path, ec) ? " is not a file" : " not found"));
-}
-
 struct Decoded {
   calib::LidarPoints points;
   std::string name;  // the lidar's frame name in calibration.yaml
@@ -65,12 +61,7 @@ Decoded decode(const CalibratePoseArgs& a, const calib::LidarPointSelection& sel
   Decoded d;
   const auto on_scan = [&](Scan&& scan) { calib::appendLidarPoints(scan, selection, d.points); };
   if (!a.config.empty()) {
-    config::RigConfig rig;
-    try {
-      rig = config::loadRigConfig(a.config);
-    } catch (const config::ConfigError& e) {
-      throw CommandFailed(fs::exists(a.config) ? kExitConfig : kExitInput, e.what());
-    }
+    const config::RigConfig rig = loadRig(a.config);
     const config::SensorConfig* sensor = nullptr;
     try {
       sensor = &rig.sensor(a.sensor);
@@ -138,9 +129,10 @@ void run(CalibratePoseArgs a) {
     throw CommandFailed(kExitUsage, "calibrate-pose: give either --config with --sensor, or --model");
   if (!a.config.empty() && a.sensor.empty())
     throw CommandFailed(kExitUsage, "calibrate-pose: --config needs --sensor NAME");
-  requireFile(a.pcap, "capture");
-  requireFile(a.poses, "pose file");
-  if (!a.config.empty()) requireFile(a.config, "rig file");
+  requireInputFile(a.pcap, "capture");
+  requireInputFile(a.poses, "pose file");
+  if (!a.config.empty()) requireInputFile(a.config, "rig file");
+  if (!a.out.empty()) prepareOutputFolder(a.out);
 
   calib::LidarPoseSettings& s = a.settings;
   s.selection.seed = a.seed;
@@ -193,10 +185,7 @@ void run(CalibratePoseArgs a) {
             << std::setprecision(3) << r.total_seconds << " s\n";
 
   if (!a.out.empty()) {
-    const fs::path out(a.out);
-    std::error_code ec;
-    fs::create_directories(out, ec);
-    if (ec) throw CommandFailed(kExitInput, cat(out.string(), ": cannot create the output folder: ", ec.message()));
+    const fs::path out(a.out);  // proven writable before the run
     try {
       calib::writeLidarPoseCalibrationText(out / "calibration.txt", r, csv.origin);
       calib::writeLidarPoseYaml(out / "calibration.yaml", r, "pose_sensor", d.name);

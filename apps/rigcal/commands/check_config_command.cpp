@@ -4,6 +4,7 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../rig_loading.hpp"
 #include "rigcal/config/rig_config.hpp"
 
 namespace rigcal::app {
@@ -14,12 +15,7 @@ void addCheckConfigCommand(CLI::App& app) {
   cmd->add_option("rig", *file, "Rig YAML file")->required();
   cmd->footer(kExitCodesHelp);
   cmd->callback([file] {
-    config::RigConfig rig;
-    try {
-      rig = config::loadRigConfig(*file);
-    } catch (const config::ConfigError& e) {
-      throw CommandFailed(kExitConfig, e.what());
-    }
+    const config::RigConfig rig = loadRig(*file);
     for (const auto& w : rig.warnings) std::cerr << "warning: " << w << '\n';
     std::cout << "rig '" << rig.name << "': " << rig.sensors.size() << " sensors, mapping lidar '"
               << rig.roles.mapping_lidar << "', base frame '" << rig.roles.base_frame << "'\n";

@@ -13,6 +13,7 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../rig_loading.hpp"
 #include "rigcal/config/config_error.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/core/pose.hpp"
@@ -80,6 +81,9 @@ std::string formatError(const Error& e) {
 }
 
 void run(const CompareOptions& o) {
+  requireInputFile(o.truth, "truth file");
+  requireInputFile(o.result, "result file");
+  if (!o.initial.empty()) requireInputFile(o.initial, "rig file");
   const YAML::Node truth = loadYaml(o.truth);
   const YAML::Node result = loadYaml(o.result);
   if (!truth["sensors"] || !truth["mapping_lidar"])
@@ -164,12 +168,10 @@ void run(const CompareOptions& o) {
 void addCompareCommand(CLI::App& app) {
   auto o = std::make_shared<CompareOptions>();
   auto* cmd = app.add_subcommand("compare", "Compare a calibration.yaml with a simulation's truth.yaml");
-  cmd->add_option("--truth", o->truth, "truth.yaml written by rigcal sim")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--truth", o->truth, "truth.yaml written by rigcal sim")->required();
   cmd->add_option("--result", o->result, "calibration.yaml written by rigcal calibrate")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--initial", o->initial, "The rig file the calibration started from, to show its guess")
-      ->check(CLI::ExistingFile);
+      ->required();
+  cmd->add_option("--initial", o->initial, "The rig file the calibration started from, to show its guess");
   cmd->add_option("--max-cm", o->max_cm, "Fail (exit 1) when a translation error exceeds this")->check(CLI::PositiveNumber);
   cmd->add_option("--max-deg", o->max_deg, "Fail (exit 1) when a rotation error exceeds this")->check(CLI::PositiveNumber);
   cmd->footer(kExitCodesHelp);

@@ -9,6 +9,8 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../output_folder.hpp"
+#include "../rig_loading.hpp"
 #include "rigcal/bag/bag_packet_source.hpp"
 #include "rigcal/core/pcd_io.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
@@ -28,15 +30,19 @@ struct DecodeOptions {
 };
 
 void writeCsv(const std::filesystem::path& path, const Scan& scan) {
-  std::ofstream out(path);
-  if (!out) throw CommandFailed(kExitFailure, path.string() + ": cannot create");
+  AtomicFile atomic(path);
+  std::ostream& out = atomic.stream();
   out << "x,y,z,intensity,ring,offset_ns\n" << std::setprecision(9);
   for (std::size_t i = 0; i < scan.size(); ++i)
     out << scan.x[i] << ',' << scan.y[i] << ',' << scan.z[i] << ',' << scan.intensity[i] << ','
         << scan.ring[i] << ',' << scan.offset_ns[i] << '\n';
+  commitOutput(atomic);
 }
 
 void run(const DecodeOptions& o) {
+  requireInputFile(o.file, "capture");
+  if (!o.calibration.empty()) requireInputFile(o.calibration, "calibration file");
+  if (!o.metadata.empty()) requireInputFile(o.metadata, "metadata file");
   drivers::DecoderConfig config;
   config.model = o.model;
   config.calibration = o.calibration;
@@ -45,6 +51,7 @@ void run(const DecodeOptions& o) {
   config.min_range_m = float(o.min_range);
   config.max_range_m = float(o.max_range);
 
+  prepareOutputFolder(o.out);
   std::unique_ptr<drivers::PacketDecoder> decoder;
   std::unique_ptr<drivers::PacketSource> source;
   if (o.file.empty() == o.bag.empty())
@@ -66,7 +73,6 @@ void run(const DecodeOptions& o) {
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());
   }
-  std::filesystem::create_directories(o.out);
 
   std::size_t written = 0;
   drivers::ScanAssembler assembler(o.model, drivers::AssemblerConfig{o.cut_angle}, [&](Scan&& scan) {
@@ -100,14 +106,12 @@ void run(const DecodeOptions& o) {
 void addDecodeCommand(CLI::App& app) {
   auto o = std::make_shared<DecodeOptions>();
   auto* cmd = app.add_subcommand("decode", "Decode a capture of one lidar into one file per scan");
-  cmd->add_option("file", o->file, "pcap or pcapng capture")->check(CLI::ExistingFile);
-  cmd->add_option("--bag", o->bag, "ROS 2 bag (rosbag2 folder, .mcap or .db3) with packet-scan messages")
-      ->check(CLI::ExistingPath);
+  cmd->add_option("file", o->file, "pcap or pcapng capture");
+  cmd->add_option("--bag", o->bag, "ROS 2 bag (rosbag2 folder, .mcap or .db3) with packet-scan messages");
   cmd->add_option("--topic", o->topic, "The bag's packet topic (needed when it holds several)");
   cmd->add_option("--sensor", o->model, "Lidar model, e.g. VLP-16, OS1-64, PandarXT32")->required();
-  cmd->add_option("--calibration", o->calibration, "Velodyne YAML/XML or Hesai angle CSV")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--metadata", o->metadata, "Ouster sensor_info JSON")->check(CLI::ExistingFile);
+  cmd->add_option("--calibration", o->calibration, "Velodyne YAML/XML or Hesai angle CSV");
+  cmd->add_option("--metadata", o->metadata, "Ouster sensor_info JSON");
   cmd->add_option("--port", o->port, "Only datagrams to this UDP port")->check(CLI::Range(1, 65535));
   cmd->add_option("--address", o->address, "Only datagrams from this sensor IPv4 address");
   cmd->add_option("--time-source", o->time_source, "sensor (packet clock) or host (capture time)")

@@ -1,15 +1,19 @@
 // `rigcal driver --config RIG --sensor NAME (--live | --pcap F [--rate R])`: one sensor's driver in its
 // own process, writing every finished scan into the shared-memory ring /rigcal.<sensor>.
+#include <iomanip>
 #include <iostream>
 #include <optional>
+#include <sstream>
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../rig_loading.hpp"
 #include "../stop_signals.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/core/cpu_latency_request.hpp"
 #include "rigcal/pipeline/sensor_driver.hpp"
 #include "rigcal/shm/ring_error.hpp"
+#include "rigcal/shm/ring_layout.hpp"
 #include "rigcal/shm/scan_ring_writer.hpp"
 
 namespace rigcal::app {
@@ -32,17 +36,38 @@ double parseRate(const std::string& text) {
   throw CommandFailed(kExitUsage, "--rate must be a positive number or 'max', got '" + text + "'");
 }
 
+// The ring is allocated in full up front (every slot holds the sensor's largest scan): bound it in bytes.
+constexpr std::uint64_t kMaxRingBytes = std::uint64_t(512) << 20;
+
+std::string mebibytes(std::uint64_t bytes) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(1) << double(bytes) / double(1 << 20);
+  return o.str();
+}
+
+void checkRingSize(unsigned slots, std::uint32_t max_points) {
+  const std::uint64_t bytes = shm::ringBytes(slots, max_points);
+  if (bytes <= kMaxRingBytes) return;
+  unsigned fits = slots;
+  while (fits > shm::kMinSlots && shm::ringBytes(fits, max_points) > kMaxRingBytes) --fits;
+  throw CommandFailed(kExitUsage, "--slots " + std::to_string(slots) + ": the ring would take " + mebibytes(bytes) +
+                                      " MiB (" + std::to_string(max_points) + " points per slot); the limit is " +
+                                      mebibytes(kMaxRingBytes) + " MiB, at most " + std::to_string(fits) +
+                                      " slots for this sensor");
+}
+
 void run(const DriverOptions& o) {
   config::RigConfig rig;
   config::SensorConfig sensor;
+  rig = loadRig(o.config);
   try {
-    rig = config::loadRigConfig(o.config);
     sensor = rig.sensor(o.sensor);
   } catch (const config::ConfigError& e) {
     throw CommandFailed(kExitConfig, e.what());
   }
   pipeline::DriverInput input;
   if (!o.live) {
+    requireInputFile(o.pcap, "capture");
     input.pcap = o.pcap;
     input.rate = parseRate(o.rate);
   }
@@ -64,14 +89,19 @@ void run(const DriverOptions& o) {
     w.sensor = sensor.name;
     w.max_points = std::uint32_t(driver->maxPointsPerScan());
     w.slot_count = o.slots;
+    checkRingSize(o.slots, w.max_points);
     if (!o.shm_prefix.empty()) w.name_prefix = o.shm_prefix;
     ring = std::make_unique<shm::ScanRingWriter>(w);
   } catch (const shm::RingError& e) {
     throw CommandFailed(kExitFailure, e.what());
+  } catch (const CommandFailed&) {
+    throw;
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());
   }
-  std::cout << "driver '" << sensor.name << "' (" << sensor.model << ") writing " << ring->segmentName()
+  std::cout << "driver '" << sensor.name << "' (" << sensor.model << ") writing " << ring->segmentName() << " ("
+            << o.slots << " slots, " << mebibytes(shm::ringBytes(o.slots, std::uint32_t(driver->maxPointsPerScan())))
+            << " MiB)"
             << (ring->tookOver() ? " (took over a stale ring)" : "") << std::endl;
 
   driver->run([&] { ring->heartbeat(); });
@@ -81,6 +111,12 @@ void run(const DriverOptions& o) {
             << " too large for a slot; " << a.packets << " packets, " << a.malformed << " malformed, "
             << a.lost_packets << " lost" << std::endl;
   if (!driver->warning().empty()) std::cerr << "warning: " << driver->warning() << '\n';
+  if (const auto& s = driver->sourceStats(); o.live && s.filtered > 0)
+    std::cerr << "warning: " << s.filtered << " datagrams on port " << sensor.source.port
+              << " dropped by the source-address filter (sensor address " << sensor.source.address.value_or("?")
+              << "), the last from " << drivers::formatIpv4(s.last_filtered.address) << ':' << s.last_filtered.port
+              << (s.last_filtered.address >> 24 == 127 ? "; a replay on this host? give the sensor 'bind: 127.0.0.1'" : "")
+              << '\n';
   if (StopSignals::requested() && !o.live) throw CommandFailed(kExitInterrupted, "driver interrupted");
 }
 
@@ -89,10 +125,10 @@ void run(const DriverOptions& o) {
 void addDriverCommand(CLI::App& app) {
   auto o = std::make_shared<DriverOptions>();
   auto* cmd = app.add_subcommand("driver", "Run one sensor's driver, writing scans into its shared-memory ring");
-  cmd->add_option("--config", o->config, "Rig YAML file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--config", o->config, "Rig YAML file")->required();
   cmd->add_option("--sensor", o->sensor, "Sensor name in the rig file")->required();
   auto* live = cmd->add_flag("--live", o->live, "Read the sensor's UDP port");
-  auto* pcap = cmd->add_option("--pcap", o->pcap, "Read a capture instead")->check(CLI::ExistingFile);
+  auto* pcap = cmd->add_option("--pcap", o->pcap, "Read a capture instead");
   live->excludes(pcap);
   cmd->add_option("--rate", o->rate, "With --pcap: 1.0 = recorded timing, 2 = twice as fast, max = no pacing")
       ->needs(pcap);

@@ -14,6 +14,8 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../rig_loading.hpp"
+#include "../output_folder.hpp"
 #include "../pipeline_options.hpp"
 #include "../stop_signals.hpp"
 #include "rigcal/config/rig_config.hpp"
@@ -32,7 +34,8 @@ struct MapArgs {
 };
 
 void writeTrajectory(const fs::path& file, const pipeline::MappingResult& m) {
-  std::ofstream out(file);
+  AtomicFile atomic(file);
+  std::ostream& out = atomic.stream();
   out << "# sequence,stamp_ns,kind,lost,path_length_m,x,y,z,qw,qx,qy,qz,lost_reason  (T_map_" << m.mapping_sensor
       << "; map = the first frame)\n";
   out << std::setprecision(9);
@@ -43,12 +46,13 @@ void writeTrajectory(const fs::path& file, const pipeline::MappingResult& m) {
         << f.path_length << ',' << t.x() << ',' << t.y() << ',' << t.z() << ',' << q.w() << ',' << q.x() << ','
         << q.y() << ',' << q.z() << ',' << f.lost_reason << '\n';
   }
-  if (!out) throw CommandFailed(kExitFailure, "cannot write " + file.string());
+  commitOutput(atomic);
 }
 
 void writeSelection(const fs::path& file, const std::vector<std::shared_ptr<const pipeline::CalibrationDataset>>& ds,
                     const std::vector<pipeline::Shortfall>& shortfalls) {
-  std::ofstream out(file);
+  AtomicFile atomic(file);
+  std::ostream& out = atomic.stream();
   for (const auto& d : ds) {
     out << d->calibration_sensor << ": " << d->frames.size() << " frames selected ("
         << (d->budget_full ? "budget full" : "end of input") << "), " << d->candidates.size() << " candidates, "
@@ -61,22 +65,13 @@ void writeSelection(const fs::path& file, const std::vector<std::shared_ptr<cons
       out << "  rejected scan " << d->candidates[r.id].scan_sequence << ": " << r.reason << '\n';
   }
   for (const auto& s : shortfalls) out << s.sensor << ": " << s.message << '\n';
-  if (!out) throw CommandFailed(kExitFailure, "cannot write " + file.string());
+  commitOutput(atomic);
 }
 
 void run(const MapArgs& a) {
-  config::RigConfig rig;
-  try {
-    rig = config::loadRigConfig(a.config);
-  } catch (const config::ConfigError& e) {
-    throw CommandFailed(kExitConfig, e.what());
-  }
+  const config::RigConfig rig = loadRig(a.config);
   const pipeline::PipelineOptions options = toPipelineOptions(a.pipeline);
-  if (!a.out.empty()) {
-    std::error_code ec;
-    fs::create_directories(a.out, ec);
-    if (ec) throw CommandFailed(kExitUsage, "--out " + a.out + ": " + ec.message());
-  }
+  if (!a.out.empty()) prepareOutputFolder(a.out);
 
   std::mutex m;
   std::vector<std::shared_ptr<const pipeline::CalibrationDataset>> datasets;
@@ -137,7 +132,7 @@ void run(const MapArgs& a) {
 void addMapCommand(CLI::App& app) {
   auto a = std::make_shared<MapArgs>();
   auto* cmd = app.add_subcommand("map", "Run the online pipeline (mapping, keyframes, pairing, selection) and write the map");
-  cmd->add_option("--config", a->config, "Rig YAML file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--config", a->config, "Rig YAML file")->required();
   addPipelineOptions(*cmd, a->pipeline);
   cmd->add_option("--out", a->out, "Write trajectory.csv, map.pcd and selection.txt here");
   cmd->footer(std::string("Stops at the end of the capture, or on Ctrl-C. ") + kExitCodesHelp);

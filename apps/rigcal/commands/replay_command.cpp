@@ -21,6 +21,7 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../rig_loading.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/drivers/packet_restamper.hpp"
 #include "rigcal/drivers/pcap_replayer.hpp"
@@ -69,12 +70,7 @@ struct Restamping {
 };
 
 std::shared_ptr<Restamping> makeRestamping(const std::string& rig_file) {
-  config::RigConfig rig;
-  try {
-    rig = config::loadRigConfig(rig_file);
-  } catch (const config::ConfigError& e) {
-    throw CommandFailed(kExitConfig, e.what());
-  }
+  const config::RigConfig rig = loadRig(rig_file);
   auto r = std::make_shared<Restamping>();
   for (const auto& sensor : rig.sensors) {
     try {
@@ -112,8 +108,7 @@ void addReplayCommand(CLI::App& app) {
   cmd->add_option("--port-offset", o->port_offset, "Added to every destination port");
   cmd->add_option("--port", o->only_port, "Send only datagrams to this destination port (0: all)");
   cmd->add_flag("--allow-remote", o->allow_remote, "Allow a target outside the loopback network");
-  cmd->add_option("--config", o->config, "Rig YAML file: which port is which sensor, to restamp their packets")
-      ->check(CLI::ExistingFile);
+  cmd->add_option("--config", o->config, "Rig YAML file: which port is which sensor, to restamp their packets");
   cmd->add_option("--clock", o->clock,
                   "now (default with --config): shift every sensor timestamp in the packets by one amount so the "
                   "capture looks recorded now, keeping the sensors' clocks consistent with each other and with "
@@ -124,6 +119,7 @@ void addReplayCommand(CLI::App& app) {
                           "receiver's current hour, Ouster/Hesai stamps on the recording day, so nothing pairs. ") +
               kExitCodesHelp);
   cmd->callback([o] {
+    requireInputFile(o->file, "capture");
     drivers::ReplayConfig config;
     try {
       config.target_address = drivers::parseIpv4(o->to);

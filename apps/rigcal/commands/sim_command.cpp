@@ -11,6 +11,7 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../output_folder.hpp"
 #include "rigcal/core/pcd_io.hpp"
 #include "rigcal/core/point_table.hpp"
 #include "rigcal/sim/outputs.hpp"
@@ -74,9 +75,7 @@ void run(const SimArgs& a) {
   if (a.perturb_translation_m) scenario.perturbation.translation_m = *a.perturb_translation_m;
   if (a.perturb_rotation_deg) scenario.perturbation.rotation_deg = *a.perturb_rotation_deg;
   const fs::path out(a.out);
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw CommandFailed(kExitInput, out.string() + ": cannot create the output folder: " + ec.message());
+  prepareOutputFolder(out);
 
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<sim::Simulation> simulation;

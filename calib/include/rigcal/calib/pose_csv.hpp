@@ -23,6 +23,12 @@ struct PoseCsvOptions {
   double recentre_above_m = 1000.0;
   /// Largest accepted | |q| − 1 | before a quaternion is rejected (accepted ones are normalised).
   double quaternion_norm_tolerance = 1e-3;
+  /// Largest accepted coordinate (metres): covers ECEF and UTM, refuses 1e300 and such.
+  double max_abs_position_m = 1e8;
+  /// Largest accepted speed between consecutive poses (m/s, 720 km/h), plus a jump allowance for a
+  /// GNSS fix that snaps back (RTK float to fixed) at any rate: a larger jump is a broken row.
+  double max_speed_mps = 200.0;
+  double jump_allowance_m = 2.0;
 };
 
 struct PoseCsv {

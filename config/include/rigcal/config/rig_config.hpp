@@ -16,11 +16,22 @@
 
 namespace rigcal::config {
 
+/// Bounds on what a rig file may ask for (a mistake or a hostile file fails at once, clearly).
+inline constexpr std::uintmax_t kMaxRigFileBytes = 1 << 20;          // a real rig file is a few kB
+inline constexpr std::size_t kMaxSensors = 64;
+inline constexpr std::size_t kMaxSensorNameLength = 64;             // names are [A-Za-z0-9_.-]+
+inline constexpr std::uintmax_t kMaxReferencedFileBytes = 16 << 20;  // calibration / metadata files
+
 /// Where a sensor's packets come from: a live UDP port, or the same port/address filter in a pcap.
 struct SensorSource {
   std::uint16_t port = 0;
   std::optional<std::string> address;          // the sensor's IPv4 address (source filter)
   std::optional<std::string> multicast_group;  // live only: join this group
+  /// Live only: the local IPv4 address to receive on (default any, 0.0.0.0). A loopback address
+  /// (127.0.0.0/8) receives from this host alone, e.g. `rigcal replay --to 127.0.0.1`: the `address`
+  /// filter is then not applied (replayed datagrams come from 127.0.0.1, not from the sensor).
+  std::optional<std::string> bind;
+  [[nodiscard]] bool bindsLoopback() const { return bind && bind->rfind("127.", 0) == 0; }
 };
 
 struct SensorConfig {

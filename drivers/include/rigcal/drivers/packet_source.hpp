@@ -26,6 +26,7 @@ struct SourceStats {
   std::uint64_t malformed = 0;       // truncated or inconsistent frames, dropped
   std::uint64_t fragments_dropped = 0;  // IPv4 fragments never completed
   std::uint64_t kernel_drops = 0;    // live sockets: datagrams the kernel reports as dropped
+  UdpEndpoint last_filtered{};       // live sockets: the source of the last datagram the filter dropped
 };
 
 class PacketSource {

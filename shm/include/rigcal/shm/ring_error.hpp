@@ -12,6 +12,7 @@ class RingError : public std::runtime_error {
     kLayoutMismatch,  // the segment was written by a build with another layout version or hash
     kCorrupted,       // not a rigcal ring, or a header whose fields contradict each other
     kSystem,          // shm_open / mmap / ftruncate / flock failed
+    kForeign,         // the segment belongs to another user or other users may open it
   };
   RingError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   [[nodiscard]] Kind kind() const { return kind_; }

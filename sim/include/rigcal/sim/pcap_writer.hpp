@@ -8,9 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <span>
 #include <vector>
 
+#include "rigcal/core/atomic_file.hpp"
 #include "rigcal/core/time.hpp"
 #include "rigcal/sim/random.hpp"
 
@@ -48,14 +50,16 @@ class PcapWriter {
                        std::span<const std::uint8_t> payload, TimeNs capture_ns);
   /// Writes one raw Ethernet frame.
   void writeFrame(std::span<const std::uint8_t> frame, TimeNs capture_ns);
-  /// Flushes and closes; throws std::runtime_error on an I/O error.
+  /// Flushes, closes and puts the file in place (written atomically: before close() or when it fails,
+  /// nothing is at the final name); throws std::runtime_error on an I/O error.
   void close();
   [[nodiscard]] std::uint64_t frames() const { return frames_; }
 
  private:
   std::filesystem::path file_;
   Options options_;
-  std::ofstream out_;
+  std::unique_ptr<AtomicFile> file_out_;
+  std::ostream& out_;
   std::map<std::uint32_t, std::uint16_t> next_id_;  // IPv4 identification per source address
   std::vector<std::uint8_t> frame_;
   std::uint64_t frames_ = 0;

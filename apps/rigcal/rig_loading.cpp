@@ -1,0 +1,41 @@
+#include "rig_loading.hpp"
+
+#include <filesystem>
+#include <fstream>
+
+#include "commands.hpp"
+#include "exit_codes.hpp"
+#include "rigcal/config/config_error.hpp"
+#include "rigcal/drivers/packet_decoder.hpp"
+#include "rigcal/pipeline/sensor_driver.hpp"
+
+namespace rigcal::app {
+
+void requireInputFile(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (!fs::exists(status)) throw CommandFailed(kExitInput, path + ": " + what + " not found");
+  if (!fs::is_regular_file(status)) throw CommandFailed(kExitInput, path + ": " + what + " is not a regular file");
+  if (!std::ifstream(path, std::ios::binary)) throw CommandFailed(kExitInput, path + ": " + what + " is not readable");
+}
+
+config::RigConfig loadRig(const std::string& path) {
+  requireInputFile(path, "rig file");
+  config::RigConfig rig;
+  try {
+    rig = config::loadRigConfig(path);
+  } catch (const config::ConfigError& e) {
+    throw CommandFailed(kExitConfig, e.what());
+  }
+  for (const auto& sensor : rig.sensors) {
+    try {
+      (void)drivers::makeDecoder(pipeline::decoderConfigFor(sensor));
+    } catch (const std::exception& e) {
+      throw CommandFailed(kExitConfig, config::ConfigError(sensor.where, "sensor '" + sensor.name + "': " + e.what()).what());
+    }
+  }
+  return rig;
+}
+
+}  // namespace rigcal::app
