@@ -1,7 +1,6 @@
 #include "rigcal/calib/cloud_pair_registration.hpp"
 
 #include <chrono>
-#include <fstream>
 #include <iomanip>
 #include <memory>
 #include <sstream>
@@ -10,6 +9,7 @@
 #include "rigcal/calib/calibration_source.hpp"
 #include "rigcal/calib/cloud_writers.hpp"
 #include "rigcal/calib/overview_png_writer.hpp"
+#include "rigcal/core/atomic_file.hpp"
 #include "rigcal/registration/icp.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
 
@@ -200,10 +200,9 @@ CloudPairResult registerCloudPair(const Scan& target_scan, const Scan& source_sc
   return finish("");
 }
 
-void writeRegistrationYaml(const std::filesystem::path& path, const CloudPairResult& r, const std::string& target_name,
-                           const std::string& source_name) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path.string() + ": cannot create");
+namespace {
+void writeRegistrationYamlTo(std::ostream& out, const CloudPairResult& r, const std::string& target_name,
+                             const std::string& source_name) {
   const auto pose = [&](const char* indent, const Pose& T) {
     const XyzRpy v = toXyzRpy(T);
     out << std::fixed << std::setprecision(6) << indent << "x: " << v.x << "\n"
@@ -257,7 +256,12 @@ void writeRegistrationYaml(const std::filesystem::path& path, const CloudPairRes
   const auto weak = r.information.weakDirections();
   for (std::size_t k = 0; k < weak.size(); ++k) out << (k ? ", " : "") << weak[k];
   out << "]\nseconds: " << r.seconds << "\n";
-  if (!out) throw std::runtime_error(path.string() + ": write failed");
+}
+}  // namespace
+
+void writeRegistrationYaml(const std::filesystem::path& path, const CloudPairResult& r, const std::string& target_name,
+                           const std::string& source_name) {
+  writeFileAtomically(path, [&](std::ostream& out) { writeRegistrationYamlTo(out, r, target_name, source_name); });
 }
 
 void writeRegistrationClouds(const std::filesystem::path& dir, const Scan& target, const Scan& source,

@@ -111,7 +111,7 @@ void run(const std::string& path) {
 void addInspectCommand(CLI::App& app) {
   auto path = std::make_shared<std::string>();
   auto* cmd = app.add_subcommand("inspect", "List a ROS 2 bag's topics, types, counts, rates, frame ids and tf edges");
-  cmd->add_option("bag", *path, "rosbag2 folder, .mcap or .db3")->required()->check(CLI::ExistingPath);
+  cmd->add_option("bag", *path, "rosbag2 folder, .mcap or .db3")->required();
   cmd->footer(kExitCodesHelp);
   cmd->callback([path] { run(*path); });
 }

@@ -11,6 +11,7 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../output_folder.hpp"
 #include "rigcal/calib/cloud_pair_registration.hpp"
 #include "rigcal/core/point_cloud_file.hpp"
 
@@ -98,6 +99,7 @@ int run(const RegisterArgs& a) {
     opt.T_target_source_guess = fromXyzRpy({a.initial[0], a.initial[1], a.initial[2], deg2rad(a.initial[3]),
                                             deg2rad(a.initial[4]), deg2rad(a.initial[5])});
   if (!a.initial_matrix.empty()) opt.T_target_source_guess = readMatrix(a.initial_matrix);
+  if (!a.out.empty()) prepareOutputFolder(a.out);
   const Scan target = readCloud(a.target);
   const Scan source = readCloud(a.source);
   config::Parameters params;
@@ -108,9 +110,6 @@ int run(const RegisterArgs& a) {
   const auto r = calib::registerCloudPair(target, source, params, opt);
 
   if (!a.out.empty()) {
-    std::error_code ec;
-    fs::create_directories(a.out, ec);
-    if (ec) throw CommandFailed(kExitInput, cat(a.out, ": cannot create the output folder: ", ec.message()));
     try {
       calib::writeRegistrationYaml(fs::path(a.out) / "registration.yaml", r, a.target, a.source);
       if (r.ok) calib::writeRegistrationClouds(a.out, target, source, r);
