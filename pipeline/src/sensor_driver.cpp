@@ -22,6 +22,7 @@ namespace {
 drivers::PacketFilter filterFor(const config::SensorConfig& sensor) {
   drivers::PacketFilter f;
   f.destination_port = sensor.source.port;
+  f.info_port = sensor.source.info_port;
   if (sensor.source.address) f.source_address = drivers::parseIpv4(*sensor.source.address);
   return f;
 }

@@ -21,6 +21,7 @@ struct SensorSource {
   std::uint16_t port = 0;
   std::optional<std::string> address;          // the sensor's IPv4 address (source filter)
   std::optional<std::string> multicast_group;  // live only: join this group
+  std::optional<std::uint16_t> info_port = std::nullopt;  // a second port of the sensor: RoboSense DIFOP (7788)
 };
 
 struct SensorConfig {
