@@ -63,6 +63,22 @@ TEST(RobosenseDecoder, DataWaitsForTheFirstDifopThenDecodes) {
   EXPECT_LT(next.packet_time_ns - out.packet_time_ns, 2 * kNsPerMs);
 }
 
+TEST(RobosenseDecoder, TheSourceFilterPassesTheDifopPortBesideTheDataPort) {
+  RIGCAL_REQUIRE_DATA(path, "robosense/helios16p.pcap");
+  auto count = [&](PacketFilter filter) {
+    PcapSource source(path, filter);
+    std::size_t n = 0;
+    while (source.next()) ++n;
+    return n;
+  };
+  PacketFilter data_only;
+  data_only.destination_port = robosense::kDefaultMsopPort;
+  PacketFilter both = data_only;
+  both.info_port = robosense::kDefaultDifopPort;
+  EXPECT_EQ(count(data_only), 750u);
+  EXPECT_EQ(count(both), 751u);
+}
+
 TEST(RobosenseDecoder, WithoutDifopNoScanIsMadeAndTheDropIsCounted) {
   RIGCAL_REQUIRE_DATA(path, "robosense/helios16p.pcap");
   Capture capture = robosense_test::loadCapture(path);
