@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "rigcal/drivers/info_port_source.hpp"
 #include "rigcal/drivers/paced_source.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
 #include "rigcal/drivers/scan_pump.hpp"
@@ -44,7 +45,10 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
       udp.port = sensor.source.port;
       udp.filter = filterFor(sensor);
       if (sensor.source.multicast_group) udp.multicast_group = *sensor.source.multicast_group;
-      source_ = std::make_unique<drivers::UdpSource>(udp);
+      if (sensor.source.info_port)
+        source_ = std::make_unique<drivers::InfoPortSource>(udp, *sensor.source.info_port);
+      else
+        source_ = std::make_unique<drivers::UdpSource>(udp);
     }
   } catch (const std::exception& e) {
     throw std::runtime_error("sensor '" + sensor.name + "': " + e.what());
