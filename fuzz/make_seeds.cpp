@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
   for (const char* sub : {"pcap", "frames", "rig", "payloads"}) fs::create_directories(out / sub);
 
   int index = 0;
-  for (const char* vendor : {"velodyne", "ouster", "hesai"}) {
+  for (const char* vendor : {"velodyne", "ouster", "hesai", "robosense"}) {
     if (!fs::is_directory(data / vendor)) continue;
     for (const auto& entry : fs::directory_iterator(data / vendor))
       if (entry.path().extension() == ".pcap") seedsFromCapture(entry.path(), out, index++);

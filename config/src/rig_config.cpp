@@ -166,7 +166,7 @@ SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
 
   const YAML::Node src = r.required(n, "source", "sensor '" + s.name + "'");
   r.requireMap(src, "source");
-  r.checkKeys(src, {"port", "address", "multicast_group", "bind"}, "source of sensor '" + s.name + "'");
+  r.checkKeys(src, {"port", "address", "multicast_group", "bind", "info_port"}, "source of sensor '" + s.name + "'");
   const YAML::Node port = r.required(src, "port", "source of sensor '" + s.name + "'");
   const long long p = r.integer(port, "port");
   r.inRange(port, "port", double(p), 1, 65535);
@@ -174,6 +174,11 @@ SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
   if (src["address"]) s.source.address = r.ipv4(src["address"], "address");
   if (src["multicast_group"]) s.source.multicast_group = r.ipv4(src["multicast_group"], "multicast_group", true);
   if (src["bind"]) s.source.bind = r.ipv4(src["bind"], "bind");
+  if (const YAML::Node info = src["info_port"]) {
+    const long long ip = r.integer(info, "info_port");
+    r.inRange(info, "info_port", double(ip), 1, 65535);
+    s.source.info_port = std::uint16_t(ip);
+  }
 
   if (n["calibration"]) s.calibration = r.existingFile(n["calibration"], "calibration");
   if (n["metadata"]) s.metadata = r.existingFile(n["metadata"], "metadata");

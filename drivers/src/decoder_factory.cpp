@@ -5,6 +5,7 @@
 #include "rigcal/drivers/hesai/hesai_decoder.hpp"
 #include "rigcal/drivers/ouster/ouster_decoder.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
+#include "rigcal/drivers/robosense/robosense_decoder.hpp"
 #include "rigcal/drivers/velodyne/velodyne_decoder.hpp"
 
 namespace rigcal::drivers {
@@ -20,6 +21,7 @@ const std::vector<Vendor>& vendors() {
       {velodyneModels, [](const DecoderConfig& c) { return makeVelodyneDecoder(c); }},
       {ousterModels, makeOusterDecoder},
       {hesaiModels, makeHesaiDecoder},
+      {robosenseModels, makeRobosenseDecoder},
   };
   return table;
 }

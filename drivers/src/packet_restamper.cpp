@@ -10,6 +10,8 @@
 #include "rigcal/drivers/ouster/ouster_decoder.hpp"
 #include "rigcal/drivers/ouster/ouster_metadata.hpp"
 #include "rigcal/drivers/ouster/ouster_packet_format.hpp"
+#include "rigcal/drivers/robosense/robosense_decoder.hpp"
+#include "rigcal/drivers/robosense/robosense_packet.hpp"
 #include "rigcal/drivers/velodyne/velodyne_decoder.hpp"
 #include "rigcal/drivers/velodyne/velodyne_packet.hpp"
 
@@ -30,7 +32,7 @@ void store(std::uint8_t* p, T v) {
 
 std::int64_t floorMod(std::int64_t a, std::int64_t m) { return ((a % m) + m) % m; }
 
-enum class Vendor : std::uint8_t { kVelodyne, kOuster, kHesai };
+enum class Vendor : std::uint8_t { kVelodyne, kOuster, kHesai, kRobosense };
 
 }  // namespace
 
@@ -86,6 +88,15 @@ struct PacketRestamper::Impl {
       store(tail + v.tail_crc_bytes, hesai::crc32Mpeg2({tail, v.tail_crc_bytes}));
     return true;
   }
+
+  // RoboSense MSOP: the header's u48 UTC seconds + u32 µs (no checksum). DIFOP packets stay as they are.
+  static bool robosense(std::span<std::uint8_t> p, std::int64_t shift_us) {
+    robosense::MsopView v;
+    if (!robosense::parseMsop(p, v).empty()) return false;
+    const std::int64_t t_us = std::int64_t(v.seconds) * 1'000'000 + v.microseconds + shift_us;
+    if (t_us < 0) return false;
+    return robosense::writeMsopTime(p, std::uint64_t(t_us / 1'000'000), std::uint32_t(t_us % 1'000'000));
+  }
 };
 
 PacketRestamper::PacketRestamper(const DecoderConfig& sensor) : impl_(std::make_unique<Impl>()) {
@@ -95,6 +106,9 @@ PacketRestamper::PacketRestamper(const DecoderConfig& sensor) : impl_(std::make_
   } else if (const hesai::ModelSpec* spec = hesai::findModel(sensor.model)) {
     impl_->vendor = Vendor::kHesai;
     impl_->hesai_spec = spec;
+  } else if (const auto robosense_models = robosenseModels();
+             std::find(robosense_models.begin(), robosense_models.end(), sensor.model) != robosense_models.end()) {
+    impl_->vendor = Vendor::kRobosense;
   } else if (const auto ouster_models = ousterModels();
              std::find(ouster_models.begin(), ouster_models.end(), sensor.model) != ouster_models.end()) {
     if (sensor.metadata.empty())
@@ -117,6 +131,7 @@ bool PacketRestamper::restamp(std::span<std::uint8_t> payload, std::int64_t shif
     case Vendor::kVelodyne: return impl_->velodyne(payload, shift_us);
     case Vendor::kOuster: return impl_->ouster(payload, shift_us);
     case Vendor::kHesai: return impl_->hesai(payload, shift_us);
+    case Vendor::kRobosense: return Impl::robosense(payload, shift_us);
   }
   return false;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "rigcal/drivers/info_port_source.hpp"
 #include "rigcal/drivers/paced_source.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
 #include "rigcal/drivers/scan_pump.hpp"
@@ -23,6 +24,7 @@ namespace {
 drivers::PacketFilter filterFor(const config::SensorConfig& sensor, bool live) {
   drivers::PacketFilter f;
   f.destination_port = sensor.source.port;
+  f.info_port = sensor.source.info_port;
   // Bound to loopback, only this host can send (a replay, from 127.0.0.1): the sensor's address cannot match.
   if (sensor.source.address && !(live && sensor.source.bindsLoopback()))
     f.source_address = drivers::parseIpv4(*sensor.source.address);
@@ -69,7 +71,10 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
       udp.filter = filterFor(sensor, true);
       if (sensor.source.bind) udp.bind_address = *sensor.source.bind;
       if (sensor.source.multicast_group) udp.multicast_group = *sensor.source.multicast_group;
-      source_ = std::make_unique<drivers::UdpSource>(udp);
+      if (sensor.source.info_port)
+        source_ = std::make_unique<drivers::InfoPortSource>(udp, *sensor.source.info_port);
+      else
+        source_ = std::make_unique<drivers::UdpSource>(udp);
     }
     tap_ = std::make_unique<ReceiveTimeTap>(*source_);
   } catch (const std::exception& e) {

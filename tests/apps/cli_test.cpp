@@ -93,5 +93,21 @@ TEST(Cli, DecodeOfACaptureWithoutThatSensorSaysSo) {
   EXPECT_NE(r.err.find("no Ouster scans decoded"), std::string::npos) << r.err;
 }
 
+TEST(Cli, DecodeRobosenseWaitsForDifopAndSaysWhenNoneCame) {
+  RIGCAL_REQUIRE_DATA(helios, "robosense/helios16p.pcap");
+  TempDir out;
+  // Both ports (MSOP 6699, DIFOP 7788): the data waits for the device-info packet, then decodes.
+  const auto r = runRigcal({"decode", helios.string(), "--sensor", "RS-Helios-16P", "--min-range", "0.2", "--out",
+                            (out / "r").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("decoded 6 scans from 751 packets (0 malformed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("scan_000001.pcd  points 15795"), std::string::npos) << r.out;
+  // The data port alone: no angle calibration, no scan, and the reason.
+  const auto d = runRigcal({"decode", helios.string(), "--sensor", "RS-Helios-16P", "--port", "6699", "--out",
+                            (out / "d").string()});
+  EXPECT_EQ(d.exit_code, 5);
+  EXPECT_NE(d.err.find("no DIFOP packet"), std::string::npos) << d.err;
+}
+
 }  // namespace
 }  // namespace rigcal::test

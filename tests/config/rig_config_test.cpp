@@ -160,5 +160,23 @@ TEST_F(RigConfigTest, IgnoredUpstreamParametersWarnInsteadOfFailing) {
   EXPECT_NE(rig.warnings[0].find("'filter_detections' is not used"), std::string::npos);
 }
 
+TEST_F(RigConfigTest, InfoPortBringsASecondPortOfTheSameSensor) {
+  const std::string rig = R"(rig: test
+sensors:
+  - name: top
+    model: RS-Helios-16P
+    source: {port: 6699, info_port: 7788}
+roles:
+  mapping_lidar: top
+)";
+  const RigConfig loaded = loadRigConfig(write(rig));
+  ASSERT_TRUE(loaded.sensor("top").source.info_port.has_value());
+  EXPECT_EQ(*loaded.sensor("top").source.info_port, 7788);
+  EXPECT_FALSE(loadRigConfig(write(kMinimal)).sensor("top").source.info_port.has_value());
+  std::string bad = rig;
+  bad.replace(bad.find("7788"), 4, "70000");
+  EXPECT_NE(errorOf(bad).find("info_port"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rigcal::config

@@ -3,11 +3,13 @@
 // the capture's receive times become "now").
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "rigcal/drivers/hesai/hesai_packet.hpp"
 #include "rigcal/drivers/packet_restamper.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
+#include "rigcal/drivers/robosense/robosense_packet.hpp"
 #include "test_data.hpp"
 
 namespace rigcal::drivers {
@@ -130,6 +132,46 @@ TEST(PacketRestamper, HesaiPandar40P64QT64AndXT32MTailTimes) {
     c.calibration = test::dataDir() / k.calibration;
     EXPECT_GT(checkShift(pcap, c, (n++ % 2) ? -kShiftUs : kShiftUs).data, 500) << k.model;
   }
+}
+
+TEST(PacketRestamper, RobosenseMsopHeaderTime) {
+  RIGCAL_REQUIRE_DATA(helios, "robosense/helios16p.pcap");
+  DecoderConfig c;
+  c.model = "RS-Helios-16P";
+  const PacketRestamper restamper(c);
+  std::vector<std::vector<std::uint8_t>> payloads;
+  PcapSource source(helios);
+  while (auto p = source.next()) payloads.emplace_back(p->payload.begin(), p->payload.end());
+  // Both decoders get the (unchanged) DIFOP first, so every data packet decodes at once.
+  const auto difop = std::find_if(payloads.begin(), payloads.end(), [](const auto& p) { return robosense::isDifop(p); });
+  ASSERT_NE(difop, payloads.end());
+  auto original = makeDecoder(c);
+  auto shifted = makeDecoder(c);
+  DecodedPacket a, b;
+  UdpPacket packet;
+  std::vector<std::uint8_t> info = *difop;
+  EXPECT_FALSE(restamper.restamp(info, kShiftUs));
+  EXPECT_EQ(info, *difop) << "DIFOP is left as it was";
+  packet.payload = info;
+  original->decode(packet, a);
+  shifted->decode(packet, b);
+  int data = 0;
+  for (const auto& payload : payloads) {
+    if (robosense::isDifop(payload)) continue;
+    std::vector<std::uint8_t> moved = payload;
+    ASSERT_TRUE(restamper.restamp(moved, -kShiftUs));
+    packet.payload = payload;
+    original->decode(packet, a);
+    packet.payload = moved;
+    shifted->decode(packet, b);
+    ASSERT_EQ(a.kind, DecodedPacket::Kind::kData);
+    ASSERT_EQ(b.kind, DecodedPacket::Kind::kData) << b.error;
+    EXPECT_EQ(b.packet_time_ns - a.packet_time_ns, -kShiftUs * 1000);
+    ASSERT_EQ(a.points.size(), b.points.size());
+    for (std::size_t i = 0; i < a.points.size(); ++i) ASSERT_EQ(b.points[i].time_ns - a.points[i].time_ns, -kShiftUs * 1000);
+    ++data;
+  }
+  EXPECT_EQ(data, int(payloads.size()) - 1);
 }
 
 TEST(PacketRestamper, ForeignPacketsAndUnknownModelsAreLeftAlone) {

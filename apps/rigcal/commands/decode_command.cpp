@@ -15,6 +15,7 @@
 #include "rigcal/core/pcd_io.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
+#include "rigcal/drivers/robosense/robosense_decoder.hpp"
 #include "rigcal/drivers/scan_assembler.hpp"
 #include "rigcal/drivers/scan_pump.hpp"
 
@@ -96,6 +97,9 @@ void run(const DecodeOptions& o) {
             << " malformed, " << a.ignored << " ignored, " << a.lost_packets << " lost; " << s.filtered
             << " other datagrams filtered out)\n";
   if (a.malformed) std::cerr << "warning: last malformed packet: " << a.last_error << '\n';
+  if (const auto* rs = dynamic_cast<const drivers::RobosenseDecoder*>(decoder.get()); rs && rs->stats().dropped_without_difop)
+    std::cerr << "warning: " << rs->stats().dropped_without_difop << " " << o.model
+              << " data packets dropped: no DIFOP packet (angle calibration, port 7788) came before the end\n";
   if (!source->warning().empty()) std::cerr << "warning: " << source->warning() << '\n';
   if (written == 0)
     throw CommandFailed(kExitNotEnoughData, (o.bag.empty() ? o.file : o.bag) + ": no " + o.model + " scans decoded");

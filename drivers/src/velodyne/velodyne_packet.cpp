@@ -10,6 +10,10 @@ namespace {
 constexpr std::int64_t kVlp16FiringCycleNs = 55'296, kVlp16FiringNs = 2'304;
 constexpr std::int64_t kVlp32FiringCycleNs = 55'296, kVlp32FiringNs = 2'304;
 constexpr std::int64_t kHdl32FiringCycleNs = 46'080, kHdl32FiringNs = 1'152;
+// HDL-32E manual, Appendix E: firing = timestamp − 542.592 + block·46.08 + DSR·1.152 µs; the timestamp is
+// written at the end of the packet, at its last firing (block 11, laser 31). A dual-return packet holds
+// 6 firing sequences, so its last firing is 5·46.08 + 31·1.152 µs after its first.
+constexpr std::int64_t kHdl32LastFiringNs = 31 * kHdl32FiringNs;
 constexpr std::int64_t kVls128SequenceNs = 53'300, kVls128GroupNs = 2'665, kVls128PacketOffsetNs = 8'700;
 constexpr double kVlp16FiringCycle = kVlp16FiringCycleNs / 1000.0;
 constexpr double kVlp32FiringCycle = kVlp32FiringCycleNs / 1000.0;
@@ -80,8 +84,10 @@ std::int64_t firingOffsetNs(Model model, bool dual, int block, int bank, int cha
       return kVlp16FiringCycleNs * (2 * b + channel / 16) + kVlp16FiringNs * (channel % 16);
     case Model::kVlp32c:
       return kVlp32FiringCycleNs * b + kVlp32FiringNs * (channel / 2);
-    case Model::kHdl32e:
-      return kHdl32FiringCycleNs * b + kHdl32FiringNs * (channel / 2);
+    case Model::kHdl32e: {
+      const std::int64_t last_sequence = dual ? 5 : 11;
+      return kHdl32FiringCycleNs * (b - last_sequence) + kHdl32FiringNs * channel - kHdl32LastFiringNs;
+    }
     case Model::kVls128: {
       const std::int64_t sequence = dual ? 0 : block / 4;
       const std::int64_t group = (bank * 32 + channel) / 8;

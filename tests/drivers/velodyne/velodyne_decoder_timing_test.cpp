@@ -40,7 +40,11 @@ TEST(VelodyneDecoder, FiringTimesFollowTheManual) {
     d->decode(b.packet(kHourStart + 1234 * kNsPerSec), out);
     ASSERT_EQ(out.points.size(), 384u) << k.model;
     const TimeNs t0 = kHourStart + TimeNs(micros) * kNsPerUs;
-    EXPECT_EQ(out.packet_time_ns, t0);
+    // The packet's first firing: the stamp itself, except the HDL-32E (stamped at its last firing).
+    EXPECT_EQ(out.packet_time_ns, t0 + std::llround(firingOffsetUs(k.m, dual, 0, 0, 0) * 1000)) << k.model;
+    if (k.m != Model::kHdl32e) {
+      EXPECT_EQ(out.packet_time_ns, t0);
+    }
     for (int blk = 0; blk < 12; ++blk)
       for (int c = 0; c < 32; ++c) {
         const Point& p = out.points[blk * 32 + c];

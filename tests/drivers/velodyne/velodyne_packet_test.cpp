@@ -59,8 +59,9 @@ TEST(VelodynePacket, Vlp16FiringOffsets) {
 TEST(VelodynePacket, Hdl32eAndVlp32cFiringOffsets) {
   for (int b = 0; b < 12; ++b)
     for (int c = 0; c < 32; ++c) {
-      EXPECT_NEAR(firingOffsetUs(Model::kHdl32e, false, b, 0, c), 46.08 * b + 1.152 * (c / 2), 1e-9);
-      EXPECT_NEAR(firingOffsetUs(Model::kHdl32e, true, b, 0, c), 46.08 * (b / 2) + 1.152 * (c / 2), 1e-9);
+      // HDL-32E: one laser every 1.152 µs, stamped at the packet's last firing (Hdl32eTimestampIsTheLastFiring).
+      EXPECT_NEAR(firingOffsetUs(Model::kHdl32e, false, b, 0, c), 46.08 * (b - 11) + 1.152 * (c - 31), 1e-9);
+      EXPECT_NEAR(firingOffsetUs(Model::kHdl32e, true, b, 0, c), 46.08 * (b / 2 - 5) + 1.152 * (c - 31), 1e-9);
       EXPECT_NEAR(firingOffsetUs(Model::kVlp32c, false, b, 0, c), 55.296 * b + 2.304 * (c / 2), 1e-9);
       EXPECT_NEAR(firingOffsetUs(Model::kVlp32c, true, b, 0, c), 55.296 * (b / 2) + 2.304 * (c / 2), 1e-9);
     }
@@ -96,13 +97,26 @@ TEST(VelodynePacket, AzimuthFractionFollowsFiringTime) {
   EXPECT_NEAR(azimuthFraction(Model::kVlp16, 0, 0), 0.0, 1e-12);
   EXPECT_NEAR(azimuthFraction(Model::kVlp16, 0, 16), 0.5, 1e-12);
   EXPECT_NEAR(azimuthFraction(Model::kVlp16, 0, 31), (55.296 + 15 * 2.304) / 110.592, 1e-12);
-  // VLP-32C/HDL-32E fire lasers in pairs.
+  // VLP-32C fires lasers in pairs, the HDL-32E one at a time (manual: 32 firings of 1.152 µs + recharge).
   EXPECT_NEAR(azimuthFraction(Model::kVlp32c, 0, 31), 15 * 2.304 / 55.296, 1e-12);
-  EXPECT_NEAR(azimuthFraction(Model::kHdl32e, 0, 31), 15 * 1.152 / 46.08, 1e-12);
+  EXPECT_NEAR(azimuthFraction(Model::kHdl32e, 0, 31), 31 * 1.152 / 46.08, 1e-12);
+  EXPECT_NE(azimuthFraction(Model::kHdl32e, 0, 4), azimuthFraction(Model::kHdl32e, 0, 5));
   EXPECT_EQ(azimuthFraction(Model::kVlp32c, 0, 4), azimuthFraction(Model::kVlp32c, 0, 5));
   // VLS-128: group 15 fires 16 slots after group 0 (one maintenance slot).
   EXPECT_NEAR(azimuthFraction(Model::kVls128, 3, 31), 16 * 2.665 / 53.3, 1e-12);
   EXPECT_NEAR(azimuthFraction(Model::kVls128, 2, 0), 9 * 2.665 / 53.3, 1e-12);
+}
+
+TEST(VelodynePacket, Hdl32eTimestampIsTheLastFiring) {
+  // HDL-32E manual, Appendix E: firing time = timestamp − 542.592 + block·46.08 + DSR·1.152 µs.
+  for (int b = 0; b < 12; ++b)
+    for (int c = 0; c < 32; ++c)
+      EXPECT_NEAR(firingOffsetUs(Model::kHdl32e, false, b, 0, c), -542.592 + b * 46.08 + c * 1.152, 1e-9);
+  EXPECT_NEAR(firingOffsetUs(Model::kHdl32e, false, 11, 0, 31), 0.0, 1e-9);
+  // Dual return: 6 firing sequences per packet, both blocks of a pair fired together.
+  EXPECT_NEAR(firingOffsetUs(Model::kHdl32e, true, 11, 0, 31), 0.0, 1e-9);
+  EXPECT_NEAR(firingOffsetUs(Model::kHdl32e, true, 0, 0, 0), -(5 * 46.08 + 31 * 1.152), 1e-9);
+  EXPECT_EQ(firingOffsetUs(Model::kHdl32e, true, 4, 0, 7), firingOffsetUs(Model::kHdl32e, true, 5, 0, 7));
 }
 
 TEST(VelodynePacket, SequencePairing) {

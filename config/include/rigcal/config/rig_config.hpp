@@ -32,6 +32,7 @@ struct SensorSource {
   /// filter is then not applied (replayed datagrams come from 127.0.0.1, not from the sensor).
   std::optional<std::string> bind;
   [[nodiscard]] bool bindsLoopback() const { return bind && bind->rfind("127.", 0) == 0; }
+  std::optional<std::uint16_t> info_port = std::nullopt;  // a second port of the sensor: RoboSense DIFOP (7788)
 };
 
 struct SensorConfig {

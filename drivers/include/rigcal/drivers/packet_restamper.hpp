@@ -4,7 +4,8 @@
 //  - Velodyne: the u32 µs past the top of the hour (modulo the hour: the receiver takes the hour from
 //    its clock, so only the minutes, seconds and µs travel);
 //  - Ouster: every column's u64 ns timestamp, and the CRC-64 footer when the firmware writes one;
-//  - Hesai: the tail's UTC date-time and µs, and the tail CRC (protocol 3.2).
+//  - Hesai: the tail's UTC date-time and µs, and the tail CRC (protocol 3.2);
+//  - RoboSense: the MSOP header's UTC seconds and µs (DIFOP device-info packets are left as they are).
 // The shift is in whole microseconds: the finest unit every vendor carries, so that sensors of
 // different vendors shifted by the same amount stay exactly as consistent as they were.
 // Packets that are not the sensor's data packets (position, IMU, GPS, foreign) are left untouched.

@@ -13,8 +13,10 @@ namespace rigcal::drivers {
 struct PacketFilter {
   std::optional<std::uint16_t> destination_port;
   std::optional<std::uint32_t> source_address;  // host byte order
+  std::optional<std::uint16_t> info_port = std::nullopt;  // the sensor's second port (RoboSense DIFOP), if any
   [[nodiscard]] bool accepts(const UdpPacket& p) const {
-    return (!destination_port || p.destination.port == *destination_port) &&
+    return (!destination_port || p.destination.port == *destination_port ||
+            (info_port && p.destination.port == *info_port)) &&
            (!source_address || p.source.address == *source_address);
   }
 };

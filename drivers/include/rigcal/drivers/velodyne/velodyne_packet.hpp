@@ -87,7 +87,8 @@ inline int laserOf(Model model, int bank, int channel) {
 /// Time of the firing of (block, channel) relative to the packet timestamp, in microseconds
 /// (Velodyne user manuals):
 ///   VLP-16   55.296·(2·b' + ⌊c/16⌋) + 2.304·(c mod 16)
-///   HDL-32E  46.08·b' + 1.152·⌊c/2⌋
+///   HDL-32E  46.08·b' + 1.152·c − T, one laser at a time; the stamp is the packet's last firing (manual,
+///            Appendix E: −542.592 + 46.08·b + 1.152·DSR), so T = 542.592 (single) or 266.112 (dual)
 ///   VLP-32C  55.296·b' + 2.304·⌊c/2⌋
 ///   VLS-128  53.3·s + 2.665·(g + ⌊g/8⌋) − 8.7, firing group g = ⌊laser/8⌋, sequence s = ⌊b/4⌋
 /// where b' = b in single-return mode and ⌊b/2⌋ in dual mode (both blocks of a pair hold the same
