@@ -76,6 +76,7 @@ registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& data
   const Pose T_scan_map = dataset.frames[frame].pairing.T_map_mapping_at_scan.inverse();
   registration::PointCloud cropped;
   for (const std::size_t i : window) {
+    if (options.deadline.expired()) return {};
     const auto& mc = dataset.mapping_clouds[i];
     const Eigen::Matrix4f T = (T_scan_map * mc.frame.T_map_lidar).matrix().cast<float>();
     const Scan& s = *mc.cloud;

@@ -24,6 +24,8 @@ void Calibrator::buildFrame(std::size_t i) {
   SourceOptions so;
   so.num_threads = opt_.num_threads;
   f.source = buildSource(*df.deskewed, params_, so);
+  // Every step of a frame's preparation that cannot be interrupted is followed by a look at the deadline.
+  if (stopped()) return;
   if (f.source.size() < std::size_t(std::max(params_.min_calibration_pointcloud_size, 10))) {
     skip << f.source.size() << " source points within the calibration range (min_calibration_pointcloud_size "
          << params_.min_calibration_pointcloud_size << ")";
@@ -32,8 +34,10 @@ void Calibrator::buildFrame(std::size_t i) {
   }
   AugmentedTargetOptions to = opt_.target;
   to.num_threads = opt_.num_threads;
+  to.deadline = deadline_;
   std::size_t clouds = 0, cropped = 0;
   auto cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds, &cropped);
+  if (stopped()) return;
   // The first frame must leave time to register: under a short deadline its target is built from
   // fewer mapping clouds (the keyframe's own always among them) rather than not at all.
   const double allowed = kFirstTargetShare * secondsLeft(deadline_);
@@ -41,6 +45,7 @@ void Calibrator::buildFrame(std::size_t i) {
     const double points_per_cloud = double(cloud.size()) / double(clouds);
     to.max_clouds = std::max<std::size_t>(1, std::size_t(allowed / (seconds_per_point_ * points_per_cloud)));
     cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds, &cropped);
+    if (stopped()) return;
   }
   // Do not start a build that the deadline would cut (a Target cannot be interrupted).
   if (!fits(deadline_, seconds_per_point_ * double(cloud.size()))) {

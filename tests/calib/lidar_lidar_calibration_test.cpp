@@ -106,6 +106,21 @@ TEST_F(LidarLidarSim, EveryRegistratorConvergesFromTheGuessWithinItsIterations) 
   }
 }
 
+// The crop of a frame's mapping clouds is the step a short deadline used to overrun on a busy machine:
+// it stops between clouds once the deadline has passed (and a cancel token stops it the same way).
+TEST_F(LidarLidarSim, AnExpiredDeadlineStopsTheTargetCrop) {
+  const auto& d = data().datasets.front();
+  const registration::PointCloud source = buildSource(*d.frames.front().deskewed, data().params, SourceOptions{});
+  AugmentedTargetOptions to;
+  EXPECT_GT(augmentedCloud(d, 0, source, data().params, to).size(), 100u) << "the frame has a target";
+  to.deadline = registration::Deadline::after(std::chrono::seconds(-1));
+  EXPECT_TRUE(augmentedCloud(d, 0, source, data().params, to).empty());
+  registration::CancelToken token;
+  token.cancel();
+  to.deadline = registration::Deadline::never(&token);
+  EXPECT_TRUE(augmentedCloud(d, 0, source, data().params, to).empty());
+}
+
 TEST_F(LidarLidarSim, RepeatedRunsGiveIdenticalResults) {
   if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
   config::Parameters params = data().params;

@@ -10,6 +10,7 @@
 
 #include "rigcal/config/parameters.hpp"
 #include "rigcal/pipeline/calibration_dataset.hpp"
+#include "rigcal/registration/deadline.hpp"
 #include "rigcal/registration/point_cloud.hpp"
 #include "rigcal/registration/target.hpp"
 
@@ -22,6 +23,9 @@ struct AugmentedTargetOptions {
   std::size_t max_clouds = 12;
   double ndt_resolution = 1.0;  // the ensemble's NDT grid
   int num_threads = 1;
+  /// The crop stops between mapping clouds once this expires and returns an empty cloud: on a busy machine
+  /// cropping a dozen clouds takes longer than a short calibration deadline.
+  registration::Deadline deadline;
 };
 
 struct AugmentedTarget {
@@ -36,7 +40,7 @@ std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& datase
                                       const config::Parameters& params, std::size_t max_clouds);
 
 /// The augmented cloud of dataset.frames[frame] (before building the Target), cropped around `source`
-/// placed by the dataset's initial extrinsic.
+/// placed by the dataset's initial extrinsic. Empty when options.deadline expired during the crop.
 registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& dataset, std::size_t frame,
                                         const registration::PointCloud& source, const config::Parameters& params,
                                         const AugmentedTargetOptions& options, std::size_t* clouds_used = nullptr,
