@@ -2,6 +2,8 @@
 // driver threads (pcap / live UDP through SensorDriver) and the shared-memory ring readers.
 #include "pipeline_impl.hpp"
 
+#include <iostream>
+
 namespace rigcal::pipeline {
 
 void Pipeline::Impl::ingest(Scan&& scan, int sensor, std::int64_t t0_ns) {
@@ -86,14 +88,18 @@ void Pipeline::Impl::startSources() {
       Scan scan;
       shm::ScanMeta meta;
       bool got_any = false;
-      while (!source_stop.load()) {
-        const auto st = readers[r]->read(scan, std::chrono::milliseconds(100), &meta);
-        if (st == shm::ReadStatus::kScan) {
-          got_any = true;
-          ingest(Scan(scan), int(r), meta.publish_ns);
-        } else if (st == shm::ReadStatus::kWriterGone && got_any) {
-          break;
+      try {
+        while (!source_stop.load()) {
+          const auto st = readers[r]->read(scan, std::chrono::milliseconds(100), &meta);
+          if (st == shm::ReadStatus::kScan) {
+            got_any = true;
+            ingest(Scan(scan), int(r), meta.publish_ns);
+          } else if (st == shm::ReadStatus::kWriterGone && got_any) {
+            break;
+          }
         }
+      } catch (const std::exception& e) {  // a ring truncated or replaced by a foreign one: this input ends
+        std::cerr << "warning: sensor '" << sensors[r] << "': " << e.what() << "\n";
       }
       --sources_running;
     });
