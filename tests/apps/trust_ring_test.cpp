@@ -1,5 +1,6 @@
 // Issue 18 (shared memory): `rigcal driver` never adopts a ring another user can touch, creates its own
-// private to its user, and bounds --slots by the bytes the ring takes.
+// private to its user, and bounds --slots by the bytes the ring takes; `rigcal map --shm` follows a driver
+// that is killed and restarted.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
