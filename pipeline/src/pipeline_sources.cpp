@@ -100,12 +100,12 @@ void Pipeline::Impl::readRing(std::size_t r) {
   shm::ScanRingReader& reader = *readers[r];
   Scan scan;
   shm::ScanMeta meta;
-  bool live = false;            // this ring's writer is counted in live_writers
+  bool live = false;                 // this ring's writer is counted in live_writers
   std::int64_t last_publish_ns = 0;  // CLOCK_MONOTONIC of the last scan read, 0 before the first
   std::uint64_t restarts = 0;
-  const auto writerGone = [&](const std::string& why) {
+  const auto writerGone = [&](const std::string& why, bool clean) {
     live = false;
-    std::cerr << "warning: sensor '" << sensor << "': " << why << "\n";
+    std::cerr << (clean ? "" : "warning: ") << "sensor '" << sensor << "': " << why << "\n";
     if (--live_writers == 0 && !options.wait_for_writers && !source_stop.load()) {
       std::cerr << "every ring writer is gone: input ends (--wait-for-writers waits for new ones)\n";
       writers_gone.store(true);
@@ -126,11 +126,13 @@ void Pipeline::Impl::readRing(std::size_t r) {
         last_publish_ns = meta.publish_ns;
         ingest(Scan(scan), int(r), meta.publish_ns);
       } else if (st == shm::ReadStatus::kWriterGone && live) {
-        writerGone(std::string("the writer of its ring is ") + shm::toString(reader.writerStatus()));
+        const shm::WriterStatus status = reader.writerStatus();
+        writerGone(std::string("the writer of its ring is ") + shm::toString(status),
+                   status == shm::WriterStatus::kClosed);
       }
     }
   } catch (const std::exception& e) {  // a ring truncated or replaced by a foreign one: this input ends
-    if (live) writerGone(e.what());
+    if (live) writerGone(e.what(), false);
     else std::cerr << "warning: sensor '" << sensor << "': " << e.what() << "\n";
   }
 }
