@@ -23,6 +23,9 @@ void addPipelineOptions(CLI::App& cmd, PipelineCliOptions& o) {
       ->needs(pcap);
   cmd.add_option("--shm-prefix", o.shm_prefix, "With --shm: ring name prefix (default $RIGCAL_SHM_PREFIX or rigcal.)")
       ->needs(shm);
+  cmd.add_flag("--wait-for-writers", o.wait_for_writers,
+               "With --shm: when every ring writer is gone, wait for new ones (default: the input ends)")
+      ->needs(shm);
   cmd.add_flag("--realtime", o.realtime, "Never wait for a slow stage: drop the oldest work (default with --live, --shm, --rate)");
   cmd.add_flag("--pin", o.pin, "Pin the pipeline's threads to the machine's cores (or --cores)");
   cmd.add_option("--cores", o.cores, "Cores to pin the threads to, e.g. 0,1 or 0-1 (implies --pin)");
@@ -50,6 +53,7 @@ pipeline::PipelineOptions toPipelineOptions(const PipelineCliOptions& o) {
   } else if (o.shm) {
     p.input = pipeline::InputKind::kShm;
     if (!o.shm_prefix.empty()) p.shm_prefix = o.shm_prefix;
+    p.wait_for_writers = o.wait_for_writers;
   } else {
     throw CommandFailed(kExitUsage, "needs an input: --pcap FILE, --live or --shm");
   }

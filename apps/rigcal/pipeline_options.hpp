@@ -14,6 +14,7 @@ struct PipelineCliOptions {
   bool live = false;
   bool shm = false;
   std::string shm_prefix;
+  bool wait_for_writers = false;
   bool realtime = false;  // force real-time mode (drop oldest) for a pcap read as fast as possible
   bool pin = false;
   std::string cores;      // e.g. "0,1"; implies --pin

@@ -51,6 +51,9 @@ PairingLane::Step PairingLane::pairNext(const MappingView& view, std::vector<Can
       (after != scans_.begin() && kf.stamp_ns - std::prev(after)->raw->stamp_ns < after->raw->stamp_ns - kf.stamp_ns))
     nearest = std::prev(after);
   const DeskewedScan& scan = *nearest;
+  // A lidar gone silent (its driver died or restarts): its last scan was offered with the first keyframe
+  // after it; offering that one old scan again with every keyframe of the gap would re-pair it across it.
+  if (after == scans_.end() && scan.raw->stamp_ns == last_paired_stamp_) return Step::kDone;
 
   std::optional<Pairing> pairing =
       pairKeyframe(view.frames, kf_frame, scan.raw->sequence, scan.raw->stamp_ns, params_);
@@ -63,6 +66,7 @@ PairingLane::Step PairingLane::pairNext(const MappingView& view, std::vector<Can
   c.keyframe_index = kf.keyframe_index;
   c.path_length = kf.path_length;
   c.t0_ns = scan.t0_ns;
+  last_paired_stamp_ = scan.raw->stamp_ns;
   const int first_kf = std::max(0, kf.keyframe_index - n);
   const int last_kf = std::min(int(view.keyframes.size()) - 1, kf.keyframe_index + n);
   c.window_begin = view.keyframes[std::size_t(first_kf)];

@@ -70,6 +70,7 @@ class PairingLane {
   std::size_t next_keyframe_ = 0;   // position in view.keyframes
   std::uint64_t scans_received_ = 0;
   std::shared_ptr<const std::vector<MappingFrame>> frames_snapshot_;
+  TimeNs last_paired_stamp_ = 0;    // of the scan in the latest candidate
 };
 
 }  // namespace rigcal::pipeline

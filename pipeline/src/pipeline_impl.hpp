@@ -147,6 +147,8 @@ struct Pipeline::Impl {
   std::vector<int> driver_sensor;  // sensor index of each driver
   std::vector<std::unique_ptr<shm::ScanRingReader>> readers;
   std::atomic<int> sources_running{0};
+  std::atomic<int> live_writers{0};          // rings whose writer delivered and is not known gone
+  std::atomic<bool> writers_gone{false};     // every ring writer seen is gone: the shm input ends
   std::mutex finish_mutex;
   std::atomic<bool> finished{false};
   std::atomic<std::uint64_t> ring_overruns{0};
@@ -203,6 +205,7 @@ struct Pipeline::Impl {
   void mappingIngested(TimeNs stamp, bool done);
   void setUpSources();
   void startSources();
+  void readRing(std::size_t r);
   void startStages();
   // Stops the driver threads / ring readers and waits for them (caller holds finish_mutex).
   void stopSources();

@@ -2,6 +2,9 @@
 // driver threads (pcap / live UDP through SensorDriver) and the shared-memory ring readers.
 #include "pipeline_impl.hpp"
 
+#include <iomanip>
+#include <iostream>
+
 namespace rigcal::pipeline {
 
 void Pipeline::Impl::ingest(Scan&& scan, int sensor, std::int64_t t0_ns) {
@@ -83,20 +86,54 @@ void Pipeline::Impl::startSources() {
   for (std::size_t r = 0; r < readers.size(); ++r) {
     ++sources_running;
     sources.emplace_back("shm:" + sensors[r], options.cores, [this, r] {
-      Scan scan;
-      shm::ScanMeta meta;
-      bool got_any = false;
-      while (!source_stop.load()) {
-        const auto st = readers[r]->read(scan, std::chrono::milliseconds(100), &meta);
-        if (st == shm::ReadStatus::kScan) {
-          got_any = true;
-          ingest(Scan(scan), int(r), meta.publish_ns);
-        } else if (st == shm::ReadStatus::kWriterGone && got_any) {
-          break;
-        }
-      }
+      readRing(r);
       --sources_running;
     });
+  }
+}
+
+// One ring's reader thread. The reader follows a restarted writer (in place: a new epoch, or a new segment)
+// by itself; here a writer that goes away and one that comes back are reported per sensor with the gap,
+// and the input ends once every writer seen is gone (unless options.wait_for_writers).
+void Pipeline::Impl::readRing(std::size_t r) {
+  const std::string& sensor = sensors[r];
+  shm::ScanRingReader& reader = *readers[r];
+  Scan scan;
+  shm::ScanMeta meta;
+  bool live = false;                 // this ring's writer is counted in live_writers
+  std::int64_t last_publish_ns = 0;  // CLOCK_MONOTONIC of the last scan read, 0 before the first
+  std::uint64_t restarts = 0;
+  const auto writerGone = [&](const std::string& why, bool clean) {
+    live = false;
+    std::cerr << (clean ? "" : "warning: ") << "sensor '" << sensor << "': " << why << "\n";
+    if (--live_writers == 0 && !options.wait_for_writers && !source_stop.load()) {
+      std::cerr << "every ring writer is gone: input ends (--wait-for-writers waits for new ones)\n";
+      writers_gone.store(true);
+    }
+  };
+  try {
+    while (!source_stop.load() && !writers_gone.load()) {
+      const auto st = reader.read(scan, std::chrono::milliseconds(100), &meta);
+      if (st == shm::ReadStatus::kScan) {
+        const bool restarted = reader.stats().writer_restarts != restarts;
+        restarts = reader.stats().writer_restarts;
+        if ((!live || restarted) && last_publish_ns != 0)
+          std::cerr << "warning: sensor '" << sensor << "': a new writer (epoch " << meta.epoch << ") after a gap of "
+                    << std::fixed << std::setprecision(2) << toSeconds(meta.publish_ns - last_publish_ns)
+                    << std::defaultfloat << " s without scans\n";
+        if (!live) ++live_writers;
+        live = true;
+        last_publish_ns = meta.publish_ns;
+        ingest(Scan(scan), int(r), meta.publish_ns);
+      } else if (st == shm::ReadStatus::kWriterGone && live) {
+        const shm::WriterStatus status = reader.writerStatus();
+        writerGone(std::string("the writer of its ring is ") + shm::toString(status),
+                   status == shm::WriterStatus::kClosed);
+      }
+    }
+  } catch (const std::exception& e) {  // a ring truncated or replaced by a foreign one: this input ends
+    if (live) writerGone(e.what(), false);
+    else std::cerr << "warning: sensor '" << sensor << "': " << e.what() << "\n";
   }
 }
 

@@ -20,6 +20,7 @@ RingInfo inspectRing(const std::string& segment, std::chrono::nanoseconds stall_
     std::optional<detail::Segment> seg = detail::Segment::open(segment, false);
     if (!seg) return info;
     info.present = true;
+    seg->requireOwnedPrivately();
     if (seg->size() < sizeof(RingHeader)) return info;  // being created
     seg->map();
     if (checkHeader(seg->base(), seg->mappedBytes(), segment) == HeaderState::kUninitialised) return info;

@@ -1,5 +1,7 @@
 #include "rigcal/shm/scan_ring_reader.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <ctime>
 
@@ -46,6 +48,8 @@ struct ScanRingReader::Impl {
 
   bool tryAttach(bool use_start_option);
   void detach();
+  [[nodiscard]] bool shrunk() const noexcept;
+  void requireIntact();
   void claimRecord();
   void releaseRecord();
   void publishRecord();
@@ -55,7 +59,9 @@ struct ScanRingReader::Impl {
 
 bool ScanRingReader::Impl::tryAttach(bool use_start_option) {
   std::optional<detail::Segment> seg = detail::Segment::open(name, true);
-  if (!seg || seg->size() < sizeof(RingHeader)) return false;  // none yet, or its writer is creating it
+  if (!seg) return false;  // none yet
+  seg->requireOwnedPrivately();  // the writer's rule: never read a ring another user could have prepared
+  if (seg->size() < sizeof(RingHeader)) return false;  // its writer is creating it
   seg->map(true);
   if (checkHeader(seg->base(), seg->mappedBytes(), name) == HeaderState::kUninitialised) return false;
   segment = std::move(*seg);
@@ -85,6 +91,26 @@ void ScanRingReader::Impl::detach() {
   attached = false;
 }
 
+/// Touching a mapped page past the end of a truncated segment raises SIGBUS, so the size is checked before
+/// the header or a slot is read. A ring shrunk under us (only its owner can, see requireOwnedPrivately) is
+/// dropped without writing to it and reported as a RingError naming it.
+bool ScanRingReader::Impl::shrunk() const noexcept {
+  struct stat st {};
+  return attached && (::fstat(segment.fd(), &st) != 0 || std::uint64_t(st.st_size) < segment.mappedBytes());
+}
+
+void ScanRingReader::Impl::requireIntact() {
+  if (!shrunk()) return;
+  const std::uint64_t mapped = segment.mappedBytes();
+  struct stat st {};
+  const long long now = ::fstat(segment.fd(), &st) == 0 ? st.st_size : -1;
+  record = -1;  // its record may be gone with the pages: do not release it
+  detach();
+  throw RingError(RingError::Kind::kCorrupted, "shared-memory ring '" + name + "' was truncated to " +
+                                                   std::to_string(now) + " of its " + std::to_string(mapped) +
+                                                   " bytes while being read: detached from it");
+}
+
 void ScanRingReader::Impl::claimRecord() {
   if (!options.publish_stats) return;
   RingHeader& h = view.header();
@@ -107,7 +133,7 @@ void ScanRingReader::Impl::claimRecord() {
 }
 
 void ScanRingReader::Impl::releaseRecord() {
-  if (record < 0 || !attached) return;
+  if (record < 0 || !attached || shrunk()) return;
   view.header().readers[record].pid.store(0, kRelease);
   record = -1;
 }
@@ -182,6 +208,7 @@ ReadStatus ScanRingReader::read(Scan& out, std::chrono::nanoseconds timeout, Sca
       sleepNs(std::min(period, deadline - now));  // poll for the segment to appear, 10 times a second
       continue;
     }
+    m.requireIntact();
     RingHeader& h = m.view.header();
     if (const std::uint64_t e = h.epoch.load(kAcquire); e != m.epoch) {  // a new writer took over in place
       ++m.stats.writer_restarts;
@@ -213,6 +240,7 @@ ReadStatus ScanRingReader::read(Scan& out, std::chrono::nanoseconds timeout, Sca
     h.waiters.fetch_add(1, kSeqCst);
     const bool ready = h.write_index.load(kSeqCst) > m.next_index || h.epoch.load(kSeqCst) != m.epoch;
     if (!ready) futexWait(h.futex_word, seen, std::chrono::nanoseconds(std::min(deadline, m.next_liveness_ns) - now));
+    m.requireIntact();  // it may have shrunk while we slept
     h.waiters.fetch_sub(1, kSeqCst);
     // A clean close also bumps the futex word: look at the writer now rather than at the next period.
     if (m.status != WriterStatus::kClosed &&
@@ -228,6 +256,7 @@ bool ScanRingReader::tryRead(Scan& out, ScanMeta* meta) {
 
 WriterStatus ScanRingReader::writerStatus() {
   Impl& m = *impl_;
+  if (m.attached) m.requireIntact();
   if (m.attached) m.status = evaluateWriter(m.view.header(), m.options.stall_after);
   return m.status;
 }
@@ -236,7 +265,7 @@ bool ScanRingReader::attached() const { return impl_->attached; }
 std::uint64_t ScanRingReader::epoch() const { return impl_->epoch; }
 std::uint64_t ScanRingReader::backlog() const {
   const Impl& m = *impl_;
-  if (!m.attached) return 0;
+  if (!m.attached || m.shrunk()) return 0;
   const std::uint64_t written = m.view.header().write_index.load(kAcquire);
   return written > m.next_index ? written - m.next_index : 0;
 }

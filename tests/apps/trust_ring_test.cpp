@@ -1,14 +1,20 @@
 // Issue 18 (shared memory): `rigcal driver` never adopts a ring another user can touch, creates its own
-// private to its user, and bounds --slots by the bytes the ring takes.
+// private to its user, and bounds --slots by the bytes the ring takes; `rigcal map --shm` follows a driver
+// that is killed and restarted.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <memory>
+#include <thread>
 
+#include "rigcal/shm/ring_inspect.hpp"
 #include "rigcal/shm/scan_ring_reader.hpp"
 #include "run_command.hpp"
 #include "test_data.hpp"
@@ -90,6 +96,46 @@ TEST_F(TrustRing, SlotsAreBoundedByBytes) {
   EXPECT_EQ(small.exit_code, 0) << small.err;
   EXPECT_NE(small.out.find("(8 slots, "), std::string::npos) << small.out;
   EXPECT_NE(small.out.find(" MiB)"), std::string::npos) << small.out;
+}
+
+// A `rigcal driver` killed and restarted under `rigcal map --shm --wait-for-writers`: map says the writer
+// died, follows the restarted driver's new epoch with the gap, and is still running to read it.
+TEST_F(TrustRing, MapFollowsARestartedDriver) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  std::vector<std::string> args = driverArgs(pcap);
+  args[8] = "0.1";  // --rate: 7 scans over 6.5 s
+  const auto ring = [&] { return shm::inspectRing(prefix_ + "roof"); };
+  const auto until = [](const std::function<bool()>& done) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!done() && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    return done();
+  };
+  RigcalProcess map({"map", "--config", rig_.string(), "--shm", "--shm-prefix", prefix_, "--wait-for-writers"});
+  auto first = std::make_unique<RigcalProcess>(args);
+  // map's reader holds a record and has read at least one scan of the first driver.
+  ASSERT_TRUE(until([&] {
+    const auto r = ring();
+    return r.readers > 0 && r.write_index >= 1 && r.max_backlog == 0;
+  }));
+  first->kill(SIGKILL);
+  (void)first->wait();
+  ASSERT_TRUE(until([&] { return ring().writer == shm::WriterStatus::kDead; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // map's reader notices (liveness: 100 ms)
+  const std::uint64_t before = ring().write_index;
+
+  RigcalProcess second(args);  // takes the dead driver's ring over: a new epoch
+  ASSERT_TRUE(until([&] {
+    const auto r = ring();
+    return r.epoch == 2 && r.write_index > before && r.max_backlog == 0 && r.readers > 0;
+  })) << "map's reader did not read the restarted driver's scans";
+  map.kill(SIGINT);
+  const CommandResult m = map.wait();
+  second.kill(SIGINT);
+  (void)second.wait();
+  EXPECT_LT(m.exit_code, 128) << m.err;
+  EXPECT_NE(m.err.find("warning: sensor 'roof': the writer of its ring is dead"), std::string::npos) << m.err;
+  EXPECT_NE(m.err.find("warning: sensor 'roof': a new writer (epoch 2) after a gap of"), std::string::npos) << m.err;
 }
 
 }  // namespace

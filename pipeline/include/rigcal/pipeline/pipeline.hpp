@@ -45,6 +45,7 @@ struct PipelineOptions {
   std::filesystem::path pcap;              // kPcap
   double rate = 0.0;                       // kPcap: replay speed (0 = as fast as possible)
   std::optional<std::string> shm_prefix;   // kShm: default $RIGCAL_SHM_PREFIX, else "rigcal."
+  bool wait_for_writers = false;           // kShm: keep waiting when every ring writer is gone
   std::vector<int> cores;                  // pin every pipeline thread to these cores (empty: no pinning)
   std::size_t queue_capacity = 32;         // per queue, in scans
 };

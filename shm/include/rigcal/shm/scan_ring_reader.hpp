@@ -5,7 +5,10 @@
 // and sleeps on the ring's futex while there is nothing new — it never spins. While it waits it checks the
 // writer every `liveness_period`: a dead writer is reported (writerStatus()), a new writer is followed —
 // in place (epoch change) or in a new segment under the same name (mapped again once the old one is
-// drained). A segment with another layout version is refused with a one-line RingError naming both.
+// drained). A segment with another layout version is refused with a one-line RingError naming both, and
+// so is one another user owns or other users may write (kForeign, checked before mapping it). A segment
+// truncated under the reader is detached from and reported (RingError kCorrupted), not touched: the size is
+// checked before the header or a slot is read (a truncation during the copy of one slot still faults).
 // A reader is used from one thread.
 #include <chrono>
 #include <cstdint>
@@ -39,14 +42,15 @@ enum class ReadStatus {
 
 class ScanRingReader {
  public:
-  /// Attaches now if the ring exists. Throws RingError (layout mismatch, corrupted header).
+  /// Attaches now if the ring exists. Throws RingError (layout mismatch, corrupted header, foreign ring).
   explicit ScanRingReader(const ReaderOptions& options);
   ~ScanRingReader();
   ScanRingReader(ScanRingReader&&) noexcept;
   ScanRingReader& operator=(ScanRingReader&&) noexcept;
 
   /// The next scan, waiting at most `timeout` for one. `out` is unspecified unless kScan.
-  /// Throws RingError if a ring that appears meanwhile has another layout or a corrupted header.
+  /// Throws RingError if a ring that appears meanwhile has another layout, a corrupted header or a foreign
+  /// owner or mode, or if the ring was truncated (the reader is then detached from it).
   ReadStatus read(Scan& out, std::chrono::nanoseconds timeout, ScanMeta* meta = nullptr);
   /// read() without waiting.
   bool tryRead(Scan& out, ScanMeta* meta = nullptr);
