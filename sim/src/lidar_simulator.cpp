@@ -33,7 +33,8 @@ Pose LidarSimulator::sensorPose(TimeNs true_time) const {
 void LidarSimulator::cast(FiringBatch& batch, std::size_t begin, std::size_t end, CastStats& stats) const {
   const LidarModel& m = *model_;
   const std::size_t nb = beams_.size();
-  const double n_radius = m.beam_origin_radius_m;
+  // Reported range = travel from the beam origin + this (Ouster: from the lidar origin; RoboSense: 0).
+  const double n_radius = m.range_from_beam_origin ? 0.0 : m.beam_origin_radius_m;
   const double unit = m.distance_unit_m;
   // Poses at each sequence's start and end; each beam's pose is interpolated at its own firing time
   // (exact to second order over ~50 µs: far below a micrometre). A sequence's end is the next one's

@@ -22,7 +22,7 @@
 
 namespace rigcal::sim {
 
-enum class LidarVendor : std::uint8_t { kVelodyne, kOuster, kHesai };
+enum class LidarVendor : std::uint8_t { kVelodyne, kOuster, kHesai, kRobosense };
 
 struct LidarBeam {
   double elevation_deg = 0;       // ω
@@ -50,6 +50,9 @@ struct LidarModel {
   // origin (travel + radius). Zero for Velodyne and Hesai.
   double beam_origin_radius_m = 0.0;
   double beam_origin_z_m = 0.0;
+  // RoboSense reports the range from the beam origin (its lens, 34.98 mm off the axis) instead: the
+  // decoder adds the lens position to range · direction.
+  bool range_from_beam_origin = false;
 
   // True when each beam sees the rotor where it stands at the beam's own firing time (Velodyne: the
   // decoder interpolates the azimuth by firing time); false when the vendor's angle table already
@@ -98,6 +101,11 @@ LidarModel makePandar64();
 // block time its earliest laser fires (the manual's table starts at −54.668 µs).
 inline constexpr std::int64_t kPandar64RoundNs = 55'560;
 inline constexpr std::int64_t kPandar64EarliestNs = 54'668;
+LidarModel makeHelios16p();
+// RS-Helios-16P: the DIFOP horizontal offset of `beam` (0.01° steps): its azimuth offset without the
+// share of the block's azimuth step the decoders give its firing slot (half the rotation during its
+// delay, lidar_models_robosense.cpp says why).
+double helios16pHorizontalOffsetDeg(const LidarModel& model, std::size_t beam);
 }  // namespace detail
 
 }  // namespace rigcal::sim
