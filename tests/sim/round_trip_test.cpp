@@ -88,9 +88,9 @@ INSTANTIATE_TEST_SUITE_P(Models, RoundTrip,
                                            ModelCase{"VLP-32C", 0.02}, ModelCase{"VLS-128", 0.02},
                                            ModelCase{"OS1-128", 0.001}, ModelCase{"PandarXT32", 0.01},
                                            ModelCase{"Pandar64", 0.01},
-                                           // Block azimuths rounded, the step between them too, and the
-                                           // slot's share of it truncated (0.005 + 0.009 + 0.01).
-                                           ModelCase{"RS-Helios-16P", 0.025, 0.006}),
+                                           // As Velodyne's: block azimuths and the step between them rounded,
+                                           // the slot's share of the step truncated to 0.01°.
+                                           ModelCase{"RS-Helios-16P", 0.02, 0.006}),
                          [](const ::testing::TestParamInfo<ModelCase>& param_info) {
                            std::string n = param_info.param.model;
                            std::erase(n, '-');
@@ -130,8 +130,7 @@ TEST(RoundTripCapture, AnOutageIsSeenAsLostPacketsByEveryVendor) {
     rigcal::test::TempDir dir;
     const Generated g = generate(sim, dir.path(), fromSeconds(kOutageFrom + 0.25));
     const test::SensorRoundTrip r =
-        test::decodeAndCompare(sim, 0, dir.path(), dir / "recording.pcap", g.recorder->sensors[0],
-                               std::string(model) == "RS-Helios-16P" ? 0.025 : 0.02);
+        test::decodeAndCompare(sim, 0, dir.path(), dir / "recording.pcap", g.recorder->sensors[0], 0.02);
     EXPECT_EQ(r.malformed, 0u) << model << ": " << r.last_error;
     EXPECT_GT(r.lost, 0u) << model;
     EXPECT_GT(r.decoded, 1000u) << model;
