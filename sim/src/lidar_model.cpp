@@ -31,7 +31,7 @@ Eigen::Vector3d LidarModel::beamOrigin(double rotor_azimuth_deg) const {
 
 Eigen::Vector3d LidarModel::point(std::size_t beam, double rotor_azimuth_deg, double range_m) const {
   const double travel = range_from_beam_origin ? range_m : range_m - beam_origin_radius_m;
-  return beamOrigin(rotor_azimuth_deg) + travel * direction(beam, rotor_azimuth_deg);
+  return beamOrigin(rotor_azimuth_deg + beams.at(beam).origin_azimuth_deg) + travel * direction(beam, rotor_azimuth_deg);
 }
 
 namespace {

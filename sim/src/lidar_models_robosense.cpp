@@ -49,14 +49,15 @@ LidarModel makeHelios16p() {
   for (std::size_t slot = 0; slot < std::size(kSlotUs); ++slot) {
     const RobosenseLaser& l = kHelios16p[slot % 16];
     const TimeNs delay = std::llround(kSlotUs[slot] * 1000.0);
-    m.beams.push_back({l.vertical * 0.01, l.horizontal * 0.01 + slotShareDeg(m.rotation_hz, delay), delay});
+    const double share = slotShareDeg(m.rotation_hz, delay);  // where the lens stands, as decoded
+    m.beams.push_back({l.vertical * 0.01, l.horizontal * 0.01 + share, delay, share});
   }
   return m;
 }
 
 double helios16pHorizontalOffsetDeg(const LidarModel& model, std::size_t beam) {
   const LidarBeam& b = model.beams.at(beam);
-  return b.azimuth_offset_deg - slotShareDeg(model.rotation_hz, b.time_offset_ns);
+  return b.azimuth_offset_deg - b.origin_azimuth_deg;
 }
 
 }  // namespace rigcal::sim::detail
