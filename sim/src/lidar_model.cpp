@@ -30,7 +30,8 @@ Eigen::Vector3d LidarModel::beamOrigin(double rotor_azimuth_deg) const {
 }
 
 Eigen::Vector3d LidarModel::point(std::size_t beam, double rotor_azimuth_deg, double range_m) const {
-  return beamOrigin(rotor_azimuth_deg) + (range_m - beam_origin_radius_m) * direction(beam, rotor_azimuth_deg);
+  const double travel = range_from_beam_origin ? range_m : range_m - beam_origin_radius_m;
+  return beamOrigin(rotor_azimuth_deg + beams.at(beam).origin_azimuth_deg) + travel * direction(beam, rotor_azimuth_deg);
 }
 
 namespace {
@@ -45,6 +46,7 @@ const std::vector<LidarModel>& registry() {
     m.push_back(detail::makeOs1_128());
     m.push_back(detail::makePandarXt32());
     m.push_back(detail::makePandar64());
+    m.push_back(detail::makeHelios16p());
     return m;
   }();
   return models;

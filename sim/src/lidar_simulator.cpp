@@ -21,8 +21,10 @@ LidarSimulator::LidarSimulator(const LidarModel& model, const Scene& scene, cons
   for (std::size_t b = 0; b < model.beamCount(); ++b) {
     // Azimuth of the beam relative to the sequence-start rotor azimuth.
     const double az = deg2rad(model.beamAzimuthDeg(b, 0.0)), el = deg2rad(model.beams[b].elevation_deg);
+    const double origin_az = deg2rad(model.beams[b].origin_azimuth_deg);
     beams_.push_back({std::cos(el), std::sin(el), std::cos(az), std::sin(az),
-                      double(model.beams[b].time_offset_ns) / double(period_ns_)});
+                      double(model.beams[b].time_offset_ns) / double(period_ns_), std::cos(origin_az), std::sin(origin_az)});
+    origin_per_beam_ = origin_per_beam_ || (origin_az != 0.0 && model.beam_origin_radius_m != 0.0);
   }
 }
 
@@ -33,7 +35,8 @@ Pose LidarSimulator::sensorPose(TimeNs true_time) const {
 void LidarSimulator::cast(FiringBatch& batch, std::size_t begin, std::size_t end, CastStats& stats) const {
   const LidarModel& m = *model_;
   const std::size_t nb = beams_.size();
-  const double n_radius = m.beam_origin_radius_m;
+  // Reported range = travel from the beam origin + this (Ouster: from the lidar origin; RoboSense: 0).
+  const double n_radius = m.range_from_beam_origin ? 0.0 : m.beam_origin_radius_m;
   const double unit = m.distance_unit_m;
   // Poses at each sequence's start and end; each beam's pose is interpolated at its own firing time
   // (exact to second order over ~50 µs: far below a micrometre). A sequence's end is the next one's
@@ -60,7 +63,14 @@ void LidarSimulator::cast(FiringBatch& batch, std::size_t begin, std::size_t end
       const Eigen::Vector3d d_s(bt.cos_el * cos_a, -bt.cos_el * sin_a, bt.sin_el);
       const double u = bt.time_fraction * inv_span;
       Ray ray;
-      ray.origin = o0 + u * (o1 - o0);
+      Eigen::Vector3d origin_b = origin_s;
+      if (origin_per_beam_) {  // the origin turned on by the beam's origin azimuth (clockwise)
+        origin_b.x() = origin_s.x() * bt.cos_origin + origin_s.y() * bt.sin_origin;
+        origin_b.y() = origin_s.y() * bt.cos_origin - origin_s.x() * bt.sin_origin;
+        ray.origin = (1 - u) * (T0 * origin_b) + u * (T1 * origin_b);
+      } else {
+        ray.origin = o0 + u * (o1 - o0);
+      }
       ray.dir = ((1 - u) * (T0.linear() * d_s) + u * (T1.linear() * d_s)).normalized();
       ++stats.rays;
       Hit hit;
@@ -89,7 +99,7 @@ void LidarSimulator::cast(FiringBatch& batch, std::size_t begin, std::size_t end
       ret.range_m = float(q);
       ret.intensity = float(std::clamp(std::round(intensity), 1.0, 255.0));
       // The point a decoder reconstructs: beam origin plus the range along the beam direction.
-      batch.points[f * nb + b] = (origin_s + (q - n_radius) * d_s).cast<float>();
+      batch.points[f * nb + b] = (origin_b + (q - n_radius) * d_s).cast<float>();
       ++stats.returns;
     }
   }

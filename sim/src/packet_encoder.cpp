@@ -9,6 +9,7 @@ std::unique_ptr<PacketEncoder> makePacketEncoder(const LidarModel& model, const 
     case LidarVendor::kVelodyne: return encoders::makeVelodyneEncoder(model, config);
     case LidarVendor::kOuster: return encoders::makeOusterEncoder(model, config);
     case LidarVendor::kHesai: return encoders::makeHesaiEncoder(model, config);
+    case LidarVendor::kRobosense: return encoders::makeRobosenseEncoder(model, config);
   }
   return nullptr;
 }

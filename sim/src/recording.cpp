@@ -58,11 +58,18 @@ RecordingSensor recordingEndpoints(const SensorSpec& s, const LidarModel& m) {
   return r;
 }
 
+std::uint16_t infoPort(const SensorSpec& s, const LidarModel& m) {
+  if (m.vendor != LidarVendor::kRobosense) return 0;
+  constexpr int kAfterData = 7788 - 6699;
+  return std::uint16_t(s.port + kAfterData <= 65535 ? s.port + kAfterData : s.port - kAfterData);
+}
+
 std::vector<std::unique_ptr<PacketEncoder>> makeEncoders(const Simulation& sim) {
   std::vector<std::unique_ptr<PacketEncoder>> out;
   for (std::size_t i = 0; i < sim.sensorCount(); ++i) {
     const SensorSpec& s = sim.scenario().sensors[i];
-    out.push_back(makePacketEncoder(sim.model(i), {s.name, s.port, false, hashKeys(sim.scenario().seed, i), s.ouster_legacy}));
+    out.push_back(makePacketEncoder(sim.model(i), {s.name, s.port, false, hashKeys(sim.scenario().seed, i),
+                                                   s.ouster_legacy, infoPort(s, sim.model(i))}));
   }
   return out;
 }

@@ -19,7 +19,8 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& file, std::vector<
 
 void RecordingWriter::add(std::size_t sensor, std::vector<EncodedPacket>& packets) {
   for (auto& p : packets)
-    queue_.push({p.send_time_ns - sensors_.at(sensor).clock_offset_ns, sensor, order_++, std::move(p.payload)});
+    queue_.push({p.send_time_ns - sensors_.at(sensor).clock_offset_ns, sensor, order_++, p.destination_port,
+                 std::move(p.payload)});
   packets.clear();
 }
 
@@ -28,7 +29,9 @@ void RecordingWriter::flushUntil(TimeNs true_time) {
     const Pending& p = queue_.top();
     const RecordingSensor& s = sensors_[p.sensor];
     const TimeNs stamp = nic_.stamp(p.send_true_ns, datagramWireTimeNs(p.payload.size()));
-    pcap_.writeDatagram(s.source, s.destination, p.payload, stamp);
+    NetEndpoint destination = s.destination;
+    if (p.port != 0) destination.port = p.port;
+    pcap_.writeDatagram(s.source, destination, p.payload, stamp);
     ++datagrams_;
     queue_.pop();
   }

@@ -7,6 +7,7 @@
 
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/random.hpp"
+#include "rigcal/sim/recording.hpp"
 #include "rigcal/core/atomic_file.hpp"
 #include "encoders/ouster_identity.hpp"
 #include "text_format.hpp"
@@ -144,6 +145,7 @@ std::pair<std::string, std::string> vendorFile(const SensorSpec& s, const LidarM
     case LidarVendor::kVelodyne: return {s.name + ".calibration.yaml", velodyneYaml(m)};
     case LidarVendor::kHesai: return {s.name + ".angles.csv", hesaiCsv(m)};
     case LidarVendor::kOuster: return {s.name + ".json", ousterJson(s, m)};
+    case LidarVendor::kRobosense: return {};  // its angles come in the DIFOP packets
   }
   return {};
 }
@@ -163,12 +165,17 @@ std::vector<std::filesystem::path> writeRigFiles(const Simulation& sim, const st
     const SensorSpec& s = sc.sensors[i];
     const LidarModel& m = sim.model(i);
     const auto [name, text] = vendorFile(s, m);
-    writeFile(dir / name, text);
-    written.push_back(dir / name);
+    if (!name.empty()) {
+      writeFile(dir / name, text);
+      written.push_back(dir / name);
+    }
     y << "  - name: " << s.name << "\n";
     y << "    model: " << s.model << "\n";
-    y << "    source: {port: " << s.port << ", address: " << s.address << ", bind: 127.0.0.1}\n";
-    y << "    " << (m.vendor == LidarVendor::kOuster ? "metadata" : "calibration") << ": " << name << "\n";
+    y << "    source: {port: " << s.port;
+    if (const std::uint16_t info = infoPort(s, m)) y << ", info_port: " << info;
+    y << ", address: " << s.address << ", bind: 127.0.0.1}\n";
+    if (!name.empty())
+      y << "    " << (m.vendor == LidarVendor::kOuster ? "metadata" : "calibration") << ": " << name << "\n";
     y << "    time_source: " << (s.time_source_sensor ? "sensor" : "host") << "\n";
   }
   y << "roles:\n";

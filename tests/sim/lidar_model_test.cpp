@@ -92,6 +92,23 @@ TEST(LidarModel, VelodynePointIsWhatTheDecoderComputes) {
   }
 }
 
+TEST(LidarModel, Helios16pPointIsWhatTheDecoderComputes) {
+  // RoboSense decoders: x = d·cosω·cos(α + δ) + Rx·cos α, y = −d·cosω·sin(α + δ) − Rx·sin α, z = d·sinω,
+  // α the block azimuth plus the slot's share (slot time / 111.12 µs) of the block's step (10 Hz ·
+  // 55.56 µs), δ the laser's DIFOP horizontal offset, Rx = 34.98 mm; d is measured from the lens.
+  const LidarModel& m = lidarModel("RS-Helios-16P");
+  const double block_az = 271.3, d = 23.4, rx = 0.03498;
+  ASSERT_EQ(m.beamCount(), 32u);
+  for (std::size_t i = 0; i < m.beamCount(); ++i) {
+    const double step_deg = 360.0 * 10.0 * 55.56e-6;
+    const double alpha = deg2rad(block_az + step_deg * double(m.beams[i].time_offset_ns) / 111'120.0);
+    const double delta = deg2rad(detail::helios16pHorizontalOffsetDeg(m, i)), w = deg2rad(m.beams[i].elevation_deg);
+    const Eigen::Vector3d expected(d * std::cos(w) * std::cos(alpha + delta) + rx * std::cos(alpha),
+                                   -d * std::cos(w) * std::sin(alpha + delta) - rx * std::sin(alpha), d * std::sin(w));
+    EXPECT_LT((m.point(i, block_az, d) - expected).norm(), 1e-9) << i;
+  }
+}
+
 TEST(LidarModel, OusterPointIsTheSdkFormulaInTheSensorFrame) {
   // Ouster: θ_enc = 2π(1 − m/W), θ_az = −2π·beam_az/360, φ = 2π·beam_alt/360, n = beam origin;
   // lidar frame x = (r − n)cos(θ_enc + θ_az)cos φ + n cos θ_enc, ..., then lidar_to_sensor (−x, −y, z + 36.18 mm).

@@ -67,12 +67,13 @@ inline SensorRoundTrip decodeAndCompare(const Simulation& sim, std::size_t index
   config.model = spec.model;
   const std::string vendor_file = vendorFile(spec, model).first;
   if (model.vendor == LidarVendor::kOuster) config.metadata = dir / vendor_file;
-  else config.calibration = dir / vendor_file;
+  else if (!vendor_file.empty()) config.calibration = dir / vendor_file;  // RoboSense: angles from DIFOP
   config.time_source = TimeSource::kSensorClock;
   auto decoder = drivers::makeDecoder(config);
   drivers::PacketFilter filter;
   filter.destination_port = spec.port;
   filter.source_address = ipv4FromText(spec.address);
+  if (const std::uint16_t info = infoPort(spec, model)) filter.info_port = info;
   drivers::PcapSource source(pcap, filter);
   std::vector<Scan> scans;
   drivers::ScanAssembler assembler(spec.name, {}, [&](Scan&& s) { scans.push_back(std::move(s)); });
@@ -84,6 +85,8 @@ inline SensorRoundTrip decodeAndCompare(const Simulation& sim, std::size_t index
   r.scans = scans.size();
   r.last_error = assembler.stats().last_error;
   const auto& firings = rec.firings;
+  // The decoders number rings by laser; RS-Helios-16P fires each of its 16 lasers twice per sequence.
+  const std::size_t rings = model.vendor == LidarVendor::kRobosense ? rec.beams / 2 : rec.beams;
   TimeNs first = std::numeric_limits<TimeNs>::max(), last = std::numeric_limits<TimeNs>::min();
   std::vector<char> seen(rec.returns.size(), 0);
   double azimuth_error_sum = 0;
@@ -91,20 +94,28 @@ inline SensorRoundTrip decodeAndCompare(const Simulation& sim, std::size_t index
   for (const Scan& scan : scans) {
     for (std::size_t i = 0; i < scan.size(); ++i) {
       ++r.decoded;
-      const std::size_t beam = scan.ring[i];
-      if (beam >= rec.beams) continue;
-      const TimeNs t = scan.pointTime(i) - model.beams[beam].time_offset_ns;
-      // The firing sequence nearest in time.
-      auto it = std::lower_bound(firings.begin(), firings.end(), t,
-                                 [](const SimFiring& f, TimeNs v) { return f.sensor_time_ns < v; });
-      if (it == firings.end() || (it != firings.begin() && t - (it - 1)->sensor_time_ns < it->sensor_time_ns - t)) --it;
-      const std::size_t f = std::size_t(it - firings.begin());
-      const std::size_t k = f * rec.beams + beam;
-      const TimeNs dt = std::abs(t - it->sensor_time_ns);
-      if (!rec.returns[k].valid || dt > 2'000 || seen[k]) continue;
-      seen[k] = 1;
+      // For each beam on this ring, the firing sequence nearest in time; of those that fired then (a
+      // laser fired twice per sequence can coincide with its next sequence's first firing), the nearest
+      // simulated point.
       const Eigen::Vector3f p(scan.x[i], scan.y[i], scan.z[i]);
-      const double e = (p - rec.points[k]).cast<double>().norm();
+      std::size_t k = rec.returns.size();
+      double e = std::numeric_limits<double>::max();
+      TimeNs dt = 0;
+      std::vector<SimFiring>::const_iterator it;
+      for (std::size_t beam = scan.ring[i]; beam < rec.beams; beam += rings) {
+        const TimeNs t = scan.pointTime(i) - model.beams[beam].time_offset_ns;
+        auto at = std::lower_bound(firings.begin(), firings.end(), t,
+                                   [](const SimFiring& f, TimeNs v) { return f.sensor_time_ns < v; });
+        if (at == firings.end() || (at != firings.begin() && t - (at - 1)->sensor_time_ns < at->sensor_time_ns - t)) --at;
+        const std::size_t candidate = std::size_t(at - firings.begin()) * rec.beams + beam;
+        const TimeNs candidate_dt = std::abs(t - at->sensor_time_ns);
+        if (candidate_dt > 2'000 || !rec.returns[candidate].valid || seen[candidate]) continue;
+        const double candidate_e = (p - rec.points[candidate]).cast<double>().norm();
+        if (candidate_e >= e) continue;
+        k = candidate, e = candidate_e, dt = candidate_dt, it = at;
+      }
+      if (k == rec.returns.size()) continue;
+      seen[k] = 1;
       r.max_error_m = std::max(r.max_error_m, e);
       r.max_excess_m = std::max(r.max_excess_m, e - quantisationBound(model, rec.returns[k].range_m, azimuth_resolution_deg));
       r.max_time_error_ns = std::max(r.max_time_error_ns, dt);

@@ -12,5 +12,6 @@ std::unique_ptr<PacketEncoder> makeOusterEncoder(const LidarModel& model, const 
 std::unique_ptr<PacketEncoder> makeHesaiEncoder(const LidarModel& model, const EncoderConfig& config);
 /// Pandar64 (pandar64_encoder.cpp); makeHesaiEncoder hands that model on to it.
 std::unique_ptr<PacketEncoder> makePandar64Encoder(const LidarModel& model, const EncoderConfig& config);
+std::unique_ptr<PacketEncoder> makeRobosenseEncoder(const LidarModel& model, const EncoderConfig& config);
 
 }  // namespace rigcal::sim::encoders

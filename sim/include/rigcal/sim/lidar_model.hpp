@@ -22,12 +22,15 @@
 
 namespace rigcal::sim {
 
-enum class LidarVendor : std::uint8_t { kVelodyne, kOuster, kHesai };
+enum class LidarVendor : std::uint8_t { kVelodyne, kOuster, kHesai, kRobosense };
 
 struct LidarBeam {
   double elevation_deg = 0;       // ω
   double azimuth_offset_deg = 0;  // added to the rotor azimuth (Velodyne: −rot_correction)
   TimeNs time_offset_ns = 0;      // when this beam fires after its sequence starts
+  // Rotor azimuth, from the sequence start's, where the beam origin stands when it fires (RS-Helios-16P:
+  // the decoders' share of the block's azimuth step; 0 for the others).
+  double origin_azimuth_deg = 0;
 };
 
 struct LidarModel {
@@ -50,6 +53,9 @@ struct LidarModel {
   // origin (travel + radius). Zero for Velodyne and Hesai.
   double beam_origin_radius_m = 0.0;
   double beam_origin_z_m = 0.0;
+  // RoboSense reports the range from the beam origin (its lens, 34.98 mm off the axis) instead: the
+  // decoder adds the lens position to range · direction.
+  bool range_from_beam_origin = false;
 
   // True when each beam sees the rotor where it stands at the beam's own firing time (Velodyne: the
   // decoder interpolates the azimuth by firing time); false when the vendor's angle table already
@@ -68,7 +74,7 @@ struct LidarModel {
   [[nodiscard]] double firingsPerRotation() const { return 1e9 / rotation_hz / firingPeriodNs(); }
   /// Unit direction of `beam` when the rotor stands at `rotor_azimuth_deg` at the sequence start.
   [[nodiscard]] Eigen::Vector3d direction(std::size_t beam, double rotor_azimuth_deg) const;
-  /// Where the beam leaves the sensor (sensor frame) at that rotor azimuth.
+  /// Where the beams leave the sensor (sensor frame) at that rotor azimuth (see LidarBeam::origin_azimuth_deg).
   [[nodiscard]] Eigen::Vector3d beamOrigin(double rotor_azimuth_deg) const;
   /// Total azimuth of a beam at a sequence starting at rotor_azimuth_deg (offset and, when the
   /// azimuth follows firing time, the rotation during the beam's delay).
@@ -98,6 +104,10 @@ LidarModel makePandar64();
 // block time its earliest laser fires (the manual's table starts at −54.668 µs).
 inline constexpr std::int64_t kPandar64RoundNs = 55'560;
 inline constexpr std::int64_t kPandar64EarliestNs = 54'668;
+LidarModel makeHelios16p();
+// RS-Helios-16P: the DIFOP horizontal offset of `beam` (0.01° steps): its azimuth offset from where its
+// lens stands (lidar_models_robosense.cpp).
+double helios16pHorizontalOffsetDeg(const LidarModel& model, std::size_t beam);
 }  // namespace detail
 
 }  // namespace rigcal::sim

@@ -40,6 +40,7 @@ class LidarSimulator {
   struct BeamTerms {
     double cos_el, sin_el, cos_az, sin_az;  // elevation and total azimuth offset
     double time_fraction;                   // firing delay / sequence period
+    double cos_origin, sin_origin;          // LidarBeam::origin_azimuth_deg
   };
   const LidarModel* model_;
   const Scene* scene_;
@@ -49,6 +50,7 @@ class LidarSimulator {
   NoiseSpec noise_;
   std::uint64_t key_;
   std::vector<BeamTerms> beams_;
+  bool origin_per_beam_ = false;  // some beam's origin stands off the sequence start's
   TimeNs period_ns_;  // sequence period, rounded (only used to place the end-of-sequence pose)
 };
 

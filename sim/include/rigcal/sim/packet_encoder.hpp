@@ -31,6 +31,8 @@ struct EncodedPacket {
   // When the sensor sends it, on the sensor's clock; never before the sensor time of the last firing
   // it carries (the capture is merged on that promise).
   TimeNs send_time_ns = 0;
+  // Where it goes: 0 for the sensor's data port; RoboSense sends its DIFOP to EncoderConfig::info_port.
+  std::uint16_t destination_port = 0;
 };
 
 /// What an encoder may need beyond the model (its packets must agree with the files rig.yaml names).
@@ -40,6 +42,7 @@ struct EncoderConfig {
   bool dual_return = false;           // single (strongest) return unless asked
   std::uint64_t seed = 0;             // for anything a real sensor randomises (e.g. initial counters)
   bool ouster_legacy = false;         // Ouster: LEGACY profile (the metadata must say so too)
+  std::uint16_t info_port = 0;        // RoboSense: the DIFOP port (rig.yaml's source info_port)
 };
 
 class PacketEncoder {

@@ -21,6 +21,10 @@ struct RecordingResult {
 /// the .100 host of its /24, Velodyne and Hesai broadcast (their defaults).
 RecordingSensor recordingEndpoints(const SensorSpec& sensor, const LidarModel& model);
 
+/// The port a sensor's second stream goes to (RoboSense DIFOP), 0 when it has none: the data port
+/// + 1089, so the vendor's default 6699 pairs with its 7788 and sensors on distinct ports stay distinct.
+std::uint16_t infoPort(const SensorSpec& sensor, const LidarModel& model);
+
 /// Encoders for every sensor (nullptr entries where a model has none yet).
 std::vector<std::unique_ptr<PacketEncoder>> makeEncoders(const Simulation& sim);
 

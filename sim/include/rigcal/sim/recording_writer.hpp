@@ -37,6 +37,7 @@ class RecordingWriter {
     TimeNs send_true_ns;
     std::size_t sensor;
     std::uint64_t order;  // FIFO among equal times
+    std::uint16_t port;   // destination port when not the sensor's (0)
     std::vector<std::uint8_t> payload;
   };
   struct Later {
