@@ -24,7 +24,7 @@ void addCheckConfigCommand(CLI::App& app) {
       const bool calibrated = std::find(rig.roles.calibration_lidars.begin(),
                                         rig.roles.calibration_lidars.end(),
                                         s.name) != rig.roles.calibration_lidars.end();
-      std::cout << "  " << std::left << std::setw(12) << s.name << std::setw(12) << s.model << "port "
+      std::cout << "  " << std::left << std::setw(12) << s.name << std::setw(14) << s.model << "port "
                 << std::setw(6) << s.source.port
                 << (s.name == rig.roles.mapping_lidar ? "mapping    " : calibrated ? "calibration" : "other      ")
                 << std::fixed << std::setprecision(3) << "  xyz " << v.x << ' ' << v.y << ' ' << v.z
