@@ -41,7 +41,9 @@ void writeCsv(const std::filesystem::path& path, const Scan& scan) {
 }
 
 void run(const DecodeOptions& o) {
-  requireInputFile(o.file, "capture");
+  if (o.file.empty() == o.bag.empty())
+    throw CommandFailed(kExitUsage, "decode: give either a capture FILE or --bag PATH");
+  if (!o.file.empty()) requireInputFile(o.file, "capture");
   if (!o.calibration.empty()) requireInputFile(o.calibration, "calibration file");
   if (!o.metadata.empty()) requireInputFile(o.metadata, "metadata file");
   drivers::DecoderConfig config;
@@ -55,8 +57,6 @@ void run(const DecodeOptions& o) {
   prepareOutputFolder(o.out);
   std::unique_ptr<drivers::PacketDecoder> decoder;
   std::unique_ptr<drivers::PacketSource> source;
-  if (o.file.empty() == o.bag.empty())
-    throw CommandFailed(kExitUsage, "decode: give either a capture FILE or --bag PATH");
   if (!o.bag.empty() && (o.port || !o.address.empty()))
     throw CommandFailed(kExitUsage, "decode: --port/--address filter pcap datagrams; with --bag choose --topic");
   try {
