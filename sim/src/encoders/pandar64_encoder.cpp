@@ -17,6 +17,7 @@
 
 #include "encoder_util.hpp"
 #include "encoders.hpp"
+#include "packet_slots.hpp"
 #include "rigcal/core/civil_date.hpp"
 #include "rigcal/sim/random.hpp"
 
@@ -41,31 +42,24 @@ class Pandar64Encoder final : public PacketEncoder {
   void add(const FiringBatch& batch, std::vector<EncodedPacket>& out) override {
     for (std::size_t f = 0; f < batch.size(); ++f) {
       const SimFiring& firing = batch.firings[f];
-      const std::int64_t index = floorDivNs(firing.sequence, kBlocks);
-      const int block = int(firing.sequence - index * kBlocks);
-      if (filled_ >= 0 && (index != index_ || block != filled_)) filled_ = -1;  // incomplete: dropped
-      if (filled_ < 0) {
-        if (block != 0) continue;
-        begin(index, firing);
-      }
+      const int block = slots_.place(firing.sequence);
+      if (block < 0) continue;
+      if (block == 0) begin(slots_.packetIndex(), firing);
       write(block, firing, batch.returnsOf(f));
-      if (++filled_ == kBlocks) {
+      if (slots_.written()) {
         EncodedPacket& p = out.emplace_back();
         p.payload.assign(packet_.begin(), packet_.end());
         p.send_time_ns = firing.sensor_time_ns + round_ns_;  // after the last round's last firing
-        filled_ = -1;
       }
     }
   }
 
-  void finish(std::vector<EncodedPacket>& /*out*/) override { filled_ = -1; }
+  void finish(std::vector<EncodedPacket>& /*out*/) override { slots_.reset(); }
 
   [[nodiscard]] std::string model() const override { return model_.name; }
 
  private:
   void begin(std::int64_t index, const SimFiring& first) {
-    index_ = index;
-    filled_ = 0;
     std::uint8_t* p = packet_.data();
     std::memset(p, 0, kPacketSize);
     const std::uint8_t header[kHeader] = {0xEE, 0xFF, kChannels, kBlocks, 0, 4, 0, 0};
@@ -106,8 +100,7 @@ class Pandar64Encoder final : public PacketEncoder {
   TimeNs round_ns_;
   std::uint16_t rpm_;
   std::array<std::uint8_t, kPacketSize> packet_{};
-  std::int64_t index_ = 0;
-  int filled_ = -1;
+  PacketSlots slots_{kBlocks};
 };
 
 }  // namespace

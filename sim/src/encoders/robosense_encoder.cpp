@@ -16,6 +16,7 @@
 
 #include "encoder_util.hpp"
 #include "encoders.hpp"
+#include "packet_slots.hpp"
 #include "rigcal/sim/random.hpp"
 
 namespace rigcal::sim::encoders {
@@ -49,11 +50,9 @@ class RobosenseEncoder final : public PacketEncoder {
   void add(const FiringBatch& batch, std::vector<EncodedPacket>& out) override {
     for (std::size_t f = 0; f < batch.size(); ++f) {
       const SimFiring& firing = batch.firings[f];
-      const std::int64_t index = floorDivNs(firing.sequence, kBlocks);
-      const int block = int(firing.sequence - index * kBlocks);
-      if (filled_ >= 0 && (index != index_ || block != filled_)) filled_ = -1;  // incomplete: dropped
-      if (filled_ < 0) {
-        if (block != 0) continue;
+      const int block = slots_.place(firing.sequence);
+      if (block < 0) continue;
+      if (block == 0) {
         if (!next_difop_ns_ || firing.sensor_time_ns >= *next_difop_ns_) {
           EncodedPacket& d = out.emplace_back();
           d.payload.assign(difop_.begin(), difop_.end());
@@ -61,19 +60,18 @@ class RobosenseEncoder final : public PacketEncoder {
           d.destination_port = info_port_;
           next_difop_ns_ = firing.sensor_time_ns + kDifopPeriodNs;
         }
-        begin(index, firing);
+        begin(slots_.packetIndex(), firing);
       }
       write(block, firing, batch.returnsOf(f));
-      if (++filled_ == kBlocks) {
+      if (slots_.written()) {
         EncodedPacket& p = out.emplace_back();
         p.payload.assign(msop_.begin(), msop_.end());
         p.send_time_ns = firing.sensor_time_ns + model_.beams.back().time_offset_ns + 1'000;  // after its last slot
-        filled_ = -1;
       }
     }
   }
 
-  void finish(std::vector<EncodedPacket>& /*out*/) override { filled_ = -1; }
+  void finish(std::vector<EncodedPacket>& /*out*/) override { slots_.reset(); }
 
   [[nodiscard]] std::string model() const override { return model_.name; }
 
@@ -95,8 +93,6 @@ class RobosenseEncoder final : public PacketEncoder {
   }
 
   void begin(std::int64_t index, const SimFiring& first) {
-    index_ = index;
-    filled_ = 0;
     std::uint8_t* p = msop_.data();
     std::memset(p, 0, kPacketSize);
     const std::uint8_t id[4] = {0x55, 0xAA, 0x05, 0x5A};
@@ -130,8 +126,7 @@ class RobosenseEncoder final : public PacketEncoder {
   double inv_unit_;
   std::array<std::uint8_t, kPacketSize> msop_{}, difop_{};
   std::optional<TimeNs> next_difop_ns_;
-  std::int64_t index_ = 0;
-  int filled_ = -1;
+  PacketSlots slots_{kBlocks};
 };
 
 }  // namespace

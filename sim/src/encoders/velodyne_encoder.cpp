@@ -12,6 +12,7 @@
 
 #include "encoder_util.hpp"
 #include "encoders.hpp"
+#include "packet_slots.hpp"
 
 namespace rigcal::sim::encoders {
 namespace {
@@ -41,32 +42,24 @@ class VelodyneEncoder final : public PacketEncoder {
   void add(const FiringBatch& batch, std::vector<EncodedPacket>& out) override {
     for (std::size_t f = 0; f < batch.size(); ++f) {
       const SimFiring& firing = batch.firings[f];
-      const std::int64_t index = floorDivNs(firing.sequence, per_packet_);
-      const int slot = int(firing.sequence - index * per_packet_);
-      // A sequence out of line (after an outage) leaves the packet in progress incomplete: dropped.
-      if (filled_ >= 0 && (index != index_ || slot != filled_)) filled_ = -1;
-      if (filled_ < 0) {
-        if (slot != 0) continue;  // wait for the next packet boundary
-        begin(index, firing);
-      }
+      const int slot = slots_.place(firing.sequence);
+      if (slot < 0) continue;
+      if (slot == 0) begin(firing);
       write(slot, firing, batch.returnsOf(f));
-      if (++filled_ == per_packet_) {
+      if (slots_.written()) {
         emit(firing, out);
-        filled_ = -1;
       }
     }
   }
 
   void finish(std::vector<EncodedPacket>& /*out*/) override {
-    filled_ = -1;  // a Velodyne packet always has twelve full blocks: a partial one is never sent
+    slots_.reset();  // a Velodyne packet always has twelve full blocks: a partial one is never sent
   }
 
   [[nodiscard]] std::string model() const override { return model_.name; }
 
  private:
-  void begin(std::int64_t index, const SimFiring& first) {
-    index_ = index;
-    filled_ = 0;
+  void begin(const SimFiring& first) {
     std::memset(packet_.data(), 0, 1200);
     const TimeNs stamp = first.sensor_time_ns + layout_.timestamp_after_first_firing_ns;
     const TimeNs micros = floorDivNs(stamp + 500, 1000);  // nearest microsecond
@@ -109,8 +102,7 @@ class VelodyneEncoder final : public PacketEncoder {
   double inv_unit_;
   TimeNs period_ns_;
   std::array<std::uint8_t, kPacketSize> packet_{};
-  std::int64_t index_ = 0;
-  int filled_ = -1;  // sequences written into the packet in progress; −1: none in progress
+  PacketSlots slots_{per_packet_};
 };
 
 }  // namespace
