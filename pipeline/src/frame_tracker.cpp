@@ -118,7 +118,10 @@ std::optional<std::string> FrameTracker::keyframeLostReason(const MappingFrame& 
     // Only over real travel: between stopped keyframes the "direction" is registration noise.
     const double min_travel = 0.5 * params_.new_keyframe_min_distance;
     if (d1.norm() > min_travel && d2.norm() > min_travel) {
-      const double angle = rad2deg(std::acos(std::clamp(d1.normalized().dot(d2.normalized()), -1.0, 1.0)));
+      double angle = rad2deg(std::acos(std::clamp(d1.normalized().dot(d2.normalized()), -1.0, 1.0)));
+      // From rest a vehicle may set off backwards along the line it came (a car changes gear at rest):
+      // after a stopped keyframe only the line of travel must hold, not its sense.
+      if (kf.kind == FrameKind::kStoppedKeyframe) angle = std::min(angle, 180.0 - angle);
       if (angle > params_.lost_frame_max_angle_diff)
         return "direction changed " + std::to_string(angle) + "° between keyframes";
     }

@@ -196,7 +196,8 @@ TrajectorySpec readTrajectory(const Reader& r, const YAML::Node& n) {
     else if (k == "jerk") seg.kind = K::kJerk;
     else r.fail(type, "segment type '" + k + "' is not one of accelerate, decelerate, cruise, stop, turn, jerk");
     seg.duration_s = r.number(r.need(s, "duration", "a trajectory segment"), "duration", 1e-3, 3600);
-    if (s["to_kmh"]) seg.to_speed_mps = r.number(s["to_kmh"], "to_kmh", 0, 200) / 3.6;
+    // Negative: reversing (at most 30 km/h backwards, like a car's reverse gear).
+    if (s["to_kmh"]) seg.to_speed_mps = r.number(s["to_kmh"], "to_kmh", -30, 200) / 3.6;
     seg.turn_rad = deg2rad(r.number(s, "turn_deg", 0, -720, 720));
     if ((seg.kind == K::kAccelerate || seg.kind == K::kJerk) && !seg.to_speed_mps)
       r.fail(s, "a '" + k + "' segment needs 'to_kmh'");

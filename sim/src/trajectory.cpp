@@ -30,20 +30,24 @@ double turnFraction(double x) { return x - std::sin(2 * M_PI * x) / (2 * M_PI); 
 Trajectory::Trajectory(TrajectorySpec spec, Ground ground) : spec_(std::move(spec)), ground_(std::move(ground)) {
   if (spec_.segments.empty()) throw std::invalid_argument("trajectory: no segments");
   double t = 0, v = spec_.start_speed_mps, s = 0, h = spec_.start_yaw_rad;
-  if (v < 0) throw std::invalid_argument("trajectory: negative start speed");
   for (std::size_t i = 0; i < spec_.segments.size(); ++i) {
     const TrajectorySegment& seg = spec_.segments[i];
     const std::string where = "trajectory segment " + std::to_string(i + 1) + " (" + kindName(seg.kind) + ")";
     if (!(seg.duration_s > 0)) throw std::invalid_argument(where + ": duration must be positive");
     const double v1 = seg.to_speed_mps.value_or(v);
-    if (v1 < 0) throw std::invalid_argument(where + ": speed must not be negative");
+    // Negative speed drives backwards. The gear changes at rest: a segment never crosses zero speed,
+    // so its arc length is monotonic and the turn's heading profile stays a function of the path.
+    if (v * v1 < 0) throw std::invalid_argument(where + ": reverses without stopping (decelerate to 0 first)");
     if (seg.kind == TrajectorySegment::Kind::kStop && (v != 0 || v1 != 0))
       throw std::invalid_argument(where + ": the vehicle must be at rest (decelerate to 0 first)");
-    const double length = 0.5 * (v + v1) * seg.duration_s;  // ∫ smoothstep blend = the mean speed
-    if (seg.turn_rad != 0 && length <= 0) throw std::invalid_argument(where + ": cannot turn while at rest");
+    // Signed: negative while reversing. ∫ smoothstep blend = the mean speed.
+    const double length = 0.5 * (v + v1) * seg.duration_s;
+    if (seg.turn_rad != 0 && length == 0) throw std::invalid_argument(where + ": cannot turn while at rest");
     segments_.push_back({t, seg.duration_s, v, v1, s, length, h, seg.turn_rad});
     t += seg.duration_s;
     s += length;
+    travelled_m_ += std::abs(length);
+    if (length < 0) reversed_m_ -= length;
     v = v1;
     h += seg.turn_rad;
   }
@@ -75,17 +79,20 @@ Trajectory::State Trajectory::state(double t_s) const {
   st.a = dv / sp.duration * 6 * u * (1 - u);
   const double local = sp.v0 * tau + dv * sp.duration * smoothstepIntegral(u);
   st.s = sp.s0 + local;
-  st.h = sp.h0 + (sp.length > 0 ? sp.turn * turnFraction(local / sp.length) : 0.0);
+  // Backwards, local and length are both negative: the fraction still runs 0 → 1, and the curvature
+  // dh/ds takes the sign a steering wheel gives it (reversing with the wheel left turns the nose right).
+  st.h = sp.h0 + (sp.length != 0 ? sp.turn * turnFraction(local / sp.length) : 0.0);
   // dh/ds = turn·H'(x)/length, H'(x) = 1 − cos(2πx).
-  st.k = sp.length > 0 ? sp.turn * (1 - std::cos(2 * M_PI * local / sp.length)) / sp.length : 0.0;
+  st.k = sp.length != 0 ? sp.turn * (1 - std::cos(2 * M_PI * local / sp.length)) / sp.length : 0.0;
   return st;
 }
 
 Eigen::Vector2d Trajectory::velocity(double t_s) const {
   const State st = state(t_s);
   // Side slip: the velocity turns off the body's axis toward the outside of the turn, by an angle
-  // proportional to the lateral acceleration v²·κ.
-  const double beta = -spec_.side_slip_rad_per_g * st.v * st.v * st.k / 9.81;
+  // proportional to the lateral acceleration v²·κ. The lateral velocity v·β is −slip·|v|·v²κ/g in either
+  // direction of travel (β's sign follows v so that backwards, too, the body slides outward).
+  const double beta = -spec_.side_slip_rad_per_g * st.v * std::abs(st.v) * st.k / 9.81;
   return st.v * Eigen::Vector2d(std::cos(st.h + beta), std::sin(st.h + beta));
 }
 

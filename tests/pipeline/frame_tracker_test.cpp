@@ -120,6 +120,36 @@ TEST(FrameTracker, KeyframeLostCheckFiresOnAFrameOffTheInterpolation) {
   EXPECT_TRUE(lost);
 }
 
+// A car changes gear at rest: forward, a stop (a stopped keyframe), then backwards along the same line.
+// The travel direction between keyframes flips by 180°, which is not a registration jump. 0.7 m/s, so
+// that stopping within a frame stays below lost_frame_max_acceleration.
+TEST(FrameTracker, ReversingAfterAStopIsNotLost) {
+  Drive d;
+  const double step = 0.07, stop = 39 * step;                 // 2.73 m east: the last moving keyframe ~0.6 m back
+  for (int i = 0; i <= 39; ++i) d.step(at(step * i));
+  for (int i = 0; i < 10; ++i) d.step(at(stop));              // a second at rest
+  for (int i = 1; i <= 43; ++i) {                             // 3 m backwards
+    const MappingFrame f = d.step(at(stop - step * i));
+    EXPECT_FALSE(f.lost) << "backwards, frame " << i << ": " << f.lost_reason;
+  }
+  const double back = stop - 43 * step;
+  for (int i = 0; i < 10; ++i) d.step(at(back));              // forwards again after a stop
+  for (int i = 1; i <= 43; ++i) {
+    const MappingFrame f = d.step(at(back + step * i));
+    EXPECT_FALSE(f.lost) << "forwards again, frame " << i << ": " << f.lost_reason;
+  }
+}
+
+TEST(FrameTracker, SettingOffSidewaysAfterAStopIsStillLost) {
+  Drive d;
+  const double step = 0.07, stop = 39 * step;
+  for (int i = 0; i <= 39; ++i) d.step(at(step * i));
+  for (int i = 0; i < 10; ++i) d.step(at(stop));
+  bool lost = false;
+  for (int i = 1; i <= 20 && !lost; ++i) lost = d.step(at(stop, step * i)).lost;  // north, the body facing east
+  EXPECT_TRUE(lost);
+}
+
 TEST(FrameTracker, AcceleratingFromAStopIsNotLost) {
   // x = a·t²/2 from rest: by time, the frames between two keyframes lag far behind a linear interpolation.
   Drive d;

@@ -2,7 +2,8 @@
 // The upstream calibrator's frame rules, fed one registered mapping-lidar pose at a time:
 // stored frame / keyframe / stopped / lost. Differences from upstream, on purpose:
 //  - a registration that failed its convergence or fitness check makes the frame lost;
-//  - the keyframe-lost check (direction change, interpolation error) fires as intended;
+//  - the keyframe-lost check (direction change, interpolation error) fires as intended, except that after a
+//    stopped keyframe the vehicle may set off backwards (a 180° flip of the travel direction is not lost);
 //  - the tracker stops by itself after mapping_max_frames stored frames (bounded memory).
 #include <deque>
 #include <optional>

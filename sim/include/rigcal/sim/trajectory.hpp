@@ -7,7 +7,8 @@
 // Smoothness: speed changes follow a smoothstep (acceleration continuous, zero at segment ends) and a
 // turn spreads its heading change with a raised-cosine curvature, so position is C2 and heading C1 in
 // time. base_link sits on the ground midway between the axles (or on the rear axle, base_link_on_rear_axle),
-// x forward, z up. base_link's origin moves along its x axis (no side slip: the kinematic rear axle)
+// x forward, z up. Negative speed drives backwards (direction changes only at rest); the turn of a
+// segment is its heading change either way. base_link's origin moves along its x axis (no side slip: the kinematic rear axle)
 // unless side_slip_rad_per_g turns its velocity off the axis, toward the outside of a turn.
 #include <optional>
 #include <string>
@@ -25,7 +26,7 @@ struct TrajectorySegment {
   enum class Kind : std::uint8_t { kAccelerate, kCruise, kStop, kTurn, kJerk };
   Kind kind = Kind::kCruise;
   double duration_s = 1.0;
-  std::optional<double> to_speed_mps;  // speed reached at the segment's end; absent: unchanged
+  std::optional<double> to_speed_mps;  // speed reached at the segment's end (negative: reversing); absent: unchanged
   double turn_rad = 0.0;               // heading change over the segment (positive: to the left)
 };
 
@@ -66,7 +67,10 @@ class Trajectory {
   [[nodiscard]] Eigen::Vector2d position(double t_s) const;
   /// Path points every `spacing` metres of travel (and the end), for keeping the road clear.
   [[nodiscard]] std::vector<Eigen::Vector2d> path(double spacing) const;
-  [[nodiscard]] double length() const { return segments_.empty() ? 0.0 : segments_.back().s0 + segments_.back().length; }
+  /// Distance driven, forwards and backwards.
+  [[nodiscard]] double length() const { return travelled_m_; }
+  /// Of which driven backwards (negative speed).
+  [[nodiscard]] double reversedLength() const { return reversed_m_; }
   [[nodiscard]] const TrajectorySpec& spec() const { return spec_; }
   /// Index of the segment active at t seconds.
   [[nodiscard]] std::size_t segmentAt(double t_s) const;
@@ -74,10 +78,10 @@ class Trajectory {
 
  private:
   struct Span {
-    double t0, duration, v0, v1, s0, length, h0, turn;
+    double t0, duration, v0, v1, s0, length, h0, turn;  // s0, length: signed arc length
   };
   struct State {
-    double s, v, a, h, k;  // arc length, speed, acceleration, heading, path curvature (1/m)
+    double s, v, a, h, k;  // signed arc length, speed, acceleration, heading, path curvature dh/ds (1/m)
   };
   [[nodiscard]] State state(double t_s) const;
   [[nodiscard]] Eigen::Vector2d velocity(double t_s) const;
@@ -86,6 +90,7 @@ class Trajectory {
   Ground ground_;
   std::vector<Span> segments_;
   TimeNs duration_ns_ = 0;
+  double travelled_m_ = 0, reversed_m_ = 0;
   double table_step_s_ = 1e-3;
   std::vector<Eigen::Vector2d> table_;  // integrated positions every table_step_s_
 };
