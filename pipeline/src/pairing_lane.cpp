@@ -1,6 +1,7 @@
 #include "pairing_lane.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "rigcal/pipeline/frame_selector.hpp"
 
@@ -29,6 +30,9 @@ void PairingLane::prune(const MappingView& view) {
   TimeNs oldest_needed = view.latest_registered;
   if (next_keyframe_ < view.keyframes.size())
     oldest_needed = std::min(oldest_needed, view.frames[view.keyframes[next_keyframe_]].stamp_ns);
+  // Before the mapper registered anything latest_registered is the lowest time: nothing is old yet (and
+  // subtracting the margin from it would overflow).
+  if (oldest_needed < std::numeric_limits<TimeNs>::min() + kKeepBeforeNs) return;
   while (scans_.size() > 1 && scans_[1].raw->stamp_ns < oldest_needed - kKeepBeforeNs) scans_.pop_front();
 }
 
