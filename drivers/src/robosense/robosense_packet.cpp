@@ -36,6 +36,10 @@ std::string parseMsop(std::span<const std::uint8_t> p, MsopView& view) {
   view.microseconds = be32(ts + 6);
   if (view.microseconds >= 1'000'000)
     return "RS-Helios-16P MSOP packet: timestamp µs field " + std::to_string(view.microseconds) + " is not below 1000000";
+  // A u48 of seconds reaches past what int64 nanoseconds hold (year 2262): such a clock is corrupt.
+  if (view.seconds > kMaxTimestampSeconds)
+    return "RS-Helios-16P MSOP packet: timestamp seconds field " + std::to_string(view.seconds) +
+           " is beyond " + std::to_string(kMaxTimestampSeconds) + " (year 2255)";
   view.counter = be32(p.data() + kCounterOffset);
   return {};
 }

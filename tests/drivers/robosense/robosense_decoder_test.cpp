@@ -160,6 +160,10 @@ TEST(RobosenseDecoder, MalformedAndForeignPacketsAreRejectedWithTheirField) {
   bad = good_msop;
   bad[robosense::kTimestampOffset + 6] = 0xFF;  // µs field ≥ 1e6
   expectMalformed(bad, "µs field");
+  // fuzz_robosense_decoder: a u48 seconds field past int64 nanoseconds overflowed the packet time (UB).
+  bad = good_msop;
+  for (int i = 0; i < 6; ++i) bad[robosense::kTimestampOffset + i] = 0xFF;
+  expectMalformed(bad, "seconds field");
   expectMalformed({good_difop.begin(), good_difop.end() - 1}, "DIFOP packet: size 1247");
   bad = good_difop;
   bad[468 + 3 * 4] = 0xFF;

@@ -26,6 +26,7 @@ inline constexpr int kChannelsPerBlock = 32;
 inline constexpr std::size_t kHeaderSize = 42;
 inline constexpr std::size_t kBlockSize = 100;
 inline constexpr std::size_t kTimestampOffset = 20;  // u48 seconds + u32 µs
+inline constexpr std::uint64_t kMaxTimestampSeconds = 9'000'000'000;  // int64 ns hold up to 9.22e9 s
 inline constexpr std::size_t kCounterOffset = 12;
 inline constexpr double kDistanceUnitM = 0.0025;
 inline constexpr double kSensorMinRangeM = 0.1;
