@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "rigcal/core/worker_pool.hpp"
 #include "rigcal/registration/deadline.hpp"
 
 namespace rigcal::registration {
@@ -38,6 +39,29 @@ TEST(Parallel, EveryTaskRunsOnceAndErrorsPropagate) {
                }),
                std::runtime_error);
   parallelFor(0, 2, [](std::size_t) { FAIL(); });
+}
+
+TEST(WorkerPool, KeepsItsThreadsAcrossCallsWithParallelForsContract) {
+  WorkerPool pool(2);
+  EXPECT_EQ(pool.threads(), 2);
+  // Many short calls on the same threads (the lidar-pose objective's pattern): each task exactly once.
+  std::vector<int> hits(64, 0);
+  for (int call = 0; call < 2000; ++call) pool.parallelFor(hits.size(), [&](std::size_t t) { ++hits[t]; });
+  for (int h : hits) EXPECT_EQ(h, 2000);
+  // The first exception comes back to the caller, and the pool still works afterwards.
+  EXPECT_THROW(pool.parallelFor(100, [](std::size_t t) {
+                 if (t == 50) throw std::runtime_error("task failed");
+               }),
+               std::runtime_error);
+  std::vector<int> after(10, 0);
+  pool.parallelFor(after.size(), [&](std::size_t t) { after[t] = static_cast<int>(t); });
+  for (std::size_t t = 0; t < after.size(); ++t) EXPECT_EQ(after[t], static_cast<int>(t));
+  pool.parallelFor(0, [](std::size_t) { FAIL(); });
+  WorkerPool single(1);
+  EXPECT_EQ(single.threads(), 1);
+  int sum = 0;
+  single.parallelFor(4, [&](std::size_t t) { sum += static_cast<int>(t); });
+  EXPECT_EQ(sum, 6);
 }
 
 TEST(Deadline, NeverAfterAndCancel) {

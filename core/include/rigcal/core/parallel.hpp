@@ -2,20 +2,55 @@
 // Deterministic 1..N-thread loops. Work is cut into tasks whose boundaries depend only on the input size
 // (never on the thread count); each task writes its own outputs or returns a partial sum, and partial sums
 // are added in task order. So a result is bit-identical whether 1 or 2 threads ran it.
-// Helper threads are started per call and joined before it returns: nothing spins while idle.
-// The one parallel loop of the project (registration, simulation).
+// Helper threads are started per call and joined before it returns: nothing spins while idle. A loop run
+// thousands of times a second keeps its threads in a WorkerPool (worker_pool.hpp) with the same contract.
+// The one parallel loop of the project (registration, simulation, the lidar-pose objective).
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <exception>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace rigcal {
 
 constexpr std::size_t chunkCount(std::size_t n, std::size_t chunk) { return (n + chunk - 1) / chunk; }
+
+namespace detail {
+// The task loop every thread of a parallel loop runs: claim the next task, run it; the first exception
+// stops the handing out of tasks and is kept for the caller.
+template <class Body>
+class TaskQueue {
+ public:
+  TaskQueue(std::size_t num_tasks, Body& body) : num_tasks_(num_tasks), body_(body) {}
+  void work() {
+    for (;;) {
+      const std::size_t t = next_.fetch_add(1, std::memory_order_relaxed);
+      if (t >= num_tasks_) return;
+      try {
+        body_(t);
+      } catch (...) {
+        const std::lock_guard lock(error_mutex_);
+        if (!error_) error_ = std::current_exception();
+        next_.store(num_tasks_, std::memory_order_relaxed);
+      }
+    }
+  }
+  void rethrow() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::size_t num_tasks_;
+  Body& body_;
+  std::atomic<std::size_t> next_{0};
+  std::exception_ptr error_;
+  std::mutex error_mutex_;
+};
+}  // namespace detail
 
 /// Calls body(task) once for each task in [0, num_tasks), on the calling thread and num_threads − 1 helpers.
 /// An exception thrown by a task is rethrown here (the first one) after all threads have stopped.
@@ -28,28 +63,13 @@ void parallelFor(std::size_t num_tasks, int num_threads, Body&& body) {
     for (std::size_t t = 0; t < num_tasks; ++t) body(t);
     return;
   }
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    for (;;) {
-      const std::size_t t = next.fetch_add(1, std::memory_order_relaxed);
-      if (t >= num_tasks) return;
-      try {
-        body(t);
-      } catch (...) {
-        const std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next.store(num_tasks, std::memory_order_relaxed);  // stop handing out tasks
-      }
-    }
-  };
+  detail::TaskQueue<std::remove_reference_t<Body>> queue(num_tasks, body);
   std::vector<std::thread> threads;
   threads.reserve(helpers);
-  for (std::size_t i = 0; i < helpers; ++i) threads.emplace_back(work);
-  work();
+  for (std::size_t i = 0; i < helpers; ++i) threads.emplace_back([&queue] { queue.work(); });
+  queue.work();
   for (auto& th : threads) th.join();
-  if (error) std::rethrow_exception(error);
+  queue.rethrow();
 }
 
 /// init + body(0) + body(1) + ... + body(num_tasks − 1), summed in that order whatever the thread count.
