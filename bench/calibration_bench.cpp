@@ -19,11 +19,11 @@
 #include <pcl/registration/ndt.h>
 
 #include "../tests/calib/lidar_lidar_sim_dataset.hpp"
-#include "rigcal/calib/augmented_target.hpp"
-#include "rigcal/calib/calibration_score.hpp"
-#include "rigcal/calib/calibration_source.hpp"
-#include "rigcal/calib/ensemble_plan.hpp"
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/augmented_target.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_source.hpp"
+#include "rigcal/calib/lidar_lidar/ensemble_plan.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 
 namespace {
 

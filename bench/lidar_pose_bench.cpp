@@ -24,8 +24,8 @@
 #include <nlopt.hpp>
 
 #include "../tests/calib/lidar_pose_synthetic.hpp"
-#include "rigcal/calib/lidar_pose_calibration.hpp"
-#include "rigcal/calib/lidar_pose_objective.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_calibration.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_objective.hpp"
 
 namespace {
 

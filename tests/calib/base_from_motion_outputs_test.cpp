@@ -1,8 +1,8 @@
 // The base_link row's sources in report.json and the summary: ground, motion or guess per component.
 #include <gtest/gtest.h>
 
-#include "rigcal/calib/report_json_writer.hpp"
-#include "rigcal/calib/summary_table.hpp"
+#include "rigcal/calib/outputs/report_json_writer.hpp"
+#include "rigcal/calib/outputs/summary_table.hpp"
 
 namespace rigcal::calib {
 namespace {

@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "rigcal/calib/base_from_motion.hpp"
+#include "rigcal/calib/base_lidar/base_from_motion.hpp"
 
 namespace rigcal::calib {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include "rigcal/calib/base_lidar_calibration.hpp"
+#include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
 
 namespace rigcal::calib {
 namespace {

@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "lidar_lidar_sim_dataset.hpp"
-#include "rigcal/calib/base_lidar_multi.hpp"
+#include "rigcal/calib/base_lidar/base_lidar_multi.hpp"
 #include "sanitizers.hpp"
 
 namespace rigcal {

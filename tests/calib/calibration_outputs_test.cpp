@@ -9,12 +9,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "rigcal/calib/calibration_outcome.hpp"
-#include "rigcal/calib/calibration_yaml_writer.hpp"
-#include "rigcal/calib/cloud_writers.hpp"
-#include "rigcal/calib/overview_png_writer.hpp"
-#include "rigcal/calib/report_json_writer.hpp"
-#include "rigcal/calib/summary_table.hpp"
+#include "rigcal/calib/outputs/calibration_outcome.hpp"
+#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
+#include "rigcal/calib/outputs/cloud_writers.hpp"
+#include "rigcal/calib/outputs/overview_png_writer.hpp"
+#include "rigcal/calib/outputs/report_json_writer.hpp"
+#include "rigcal/calib/outputs/summary_table.hpp"
 #include "rigcal/core/pcd_io.hpp"
 #include "test_data.hpp"
 

@@ -6,7 +6,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "rigcal/calib/calibration_deskew.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_deskew.hpp"
 #include "rigcal/pipeline/deskew.hpp"
 #include "rigcal/pipeline/frame_selector.hpp"
 #include "rigcal/registration/voxel_grid.hpp"

@@ -3,7 +3,7 @@
 // --deadline that would do.
 #include <gtest/gtest.h>
 
-#include "rigcal/calib/lidar_lidar_verdict.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 
 namespace rigcal::calib {
 namespace {

@@ -11,8 +11,8 @@
 #include <thread>
 
 #include "lidar_lidar_sim_dataset.hpp"
-#include "rigcal/calib/calibration_budget.hpp"
-#include "rigcal/calib/lidar_lidar_worker.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_worker.hpp"
 #include "sanitizers.hpp"
 
 namespace rigcal::calib {

@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "lidar_pose_synthetic.hpp"
-#include "rigcal/calib/lidar_pose_calibration.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_calibration.hpp"
 #include "sanitizers.hpp"
 
 namespace rigcal::calib {

@@ -7,8 +7,9 @@
 #include <random>
 #include <sstream>
 
-#include "rigcal/calib/lidar_pose_objective.hpp"
-#include "rigcal/calib/lidar_pose_output.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_objective.hpp"
+#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_output.hpp"
 #include "rigcal/core/ply_io.hpp"
 #include "test_data.hpp"
 

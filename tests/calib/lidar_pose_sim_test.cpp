@@ -7,8 +7,8 @@
 #include <cstring>
 #include <iostream>
 
-#include "rigcal/calib/lidar_pose_calibration.hpp"
-#include "rigcal/calib/pose_csv.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_calibration.hpp"
+#include "rigcal/calib/lidar_pose/pose_csv.hpp"
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/scenario.hpp"
 #include "rigcal/sim/simulation.hpp"

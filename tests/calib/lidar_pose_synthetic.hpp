@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "rigcal/calib/lidar_pose_points.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_points.hpp"
 #include "rigcal/core/pose.hpp"
 #include "rigcal/core/scan.hpp"
 

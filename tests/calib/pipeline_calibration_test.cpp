@@ -7,7 +7,7 @@
 #include <cstdlib>
 
 #include "../pipeline/sim_pipeline_util.hpp"
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 #include "rigcal/sim/scenario.hpp"
 #include "sanitizers.hpp"
 

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "rigcal/calib/pose_csv.hpp"
-#include "rigcal/calib/pose_trajectory.hpp"
+#include "rigcal/calib/lidar_pose/pose_csv.hpp"
+#include "rigcal/calib/lidar_pose/pose_trajectory.hpp"
 #include "test_data.hpp"
 
 namespace rigcal::calib {

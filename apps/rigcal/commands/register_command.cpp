@@ -12,7 +12,7 @@
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
 #include "../output_folder.hpp"
-#include "rigcal/calib/cloud_pair_registration.hpp"
+#include "rigcal/calib/lidar_lidar/cloud_pair_registration.hpp"
 #include "rigcal/core/point_cloud_file.hpp"
 
 namespace rigcal::app {

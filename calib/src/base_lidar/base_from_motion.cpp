@@ -1,4 +1,4 @@
-#include "rigcal/calib/base_from_motion.hpp"
+#include "rigcal/calib/base_lidar/base_from_motion.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rigcal/calib/base_lidar_calibration.hpp"
+#include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
 
 #include <cmath>
 

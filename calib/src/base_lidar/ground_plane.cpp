@@ -1,4 +1,4 @@
-#include "rigcal/calib/ground_plane.hpp"
+#include "rigcal/calib/base_lidar/ground_plane.hpp"
 
 #include <Eigen/Eigenvalues>
 

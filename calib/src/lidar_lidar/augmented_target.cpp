@@ -1,4 +1,4 @@
-#include "rigcal/calib/augmented_target.hpp"
+#include "rigcal/calib/lidar_lidar/augmented_target.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "rigcal/calib/calibration_budget.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rigcal/calib/calibration_deskew.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_deskew.hpp"
 
 #include <algorithm>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "rigcal/calib/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_score.hpp"
 
 #include <algorithm>
 

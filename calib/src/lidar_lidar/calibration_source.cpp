@@ -1,4 +1,4 @@
-#include "rigcal/calib/calibration_source.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_source.hpp"
 
 #include "rigcal/registration/covariance.hpp"
 

@@ -1,4 +1,4 @@
-#include "rigcal/calib/cloud_pair_global_search.hpp"
+#include "rigcal/calib/lidar_lidar/cloud_pair_global_search.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "rigcal/calib/ground_plane.hpp"
+#include "rigcal/calib/base_lidar/ground_plane.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
 
 namespace rigcal::calib {

@@ -1,14 +1,14 @@
-#include "rigcal/calib/cloud_pair_registration.hpp"
+#include "rigcal/calib/lidar_lidar/cloud_pair_registration.hpp"
 
 #include <chrono>
 #include <iomanip>
 #include <memory>
 #include <sstream>
 
-#include "rigcal/calib/calibration_outcome.hpp"
-#include "rigcal/calib/calibration_source.hpp"
-#include "rigcal/calib/cloud_writers.hpp"
-#include "rigcal/calib/overview_png_writer.hpp"
+#include "rigcal/calib/outputs/calibration_outcome.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_source.hpp"
+#include "rigcal/calib/outputs/cloud_writers.hpp"
+#include "rigcal/calib/outputs/overview_png_writer.hpp"
 #include "rigcal/core/atomic_file.hpp"
 #include "rigcal/registration/icp.hpp"
 #include "rigcal/registration/voxel_grid.hpp"

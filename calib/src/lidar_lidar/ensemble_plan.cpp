@@ -1,4 +1,4 @@
-#include "rigcal/calib/ensemble_plan.hpp"
+#include "rigcal/calib/lidar_lidar/ensemble_plan.hpp"
 
 #include "rigcal/registration/batched_icp.hpp"
 #include "rigcal/registration/gicp.hpp"

@@ -1,4 +1,4 @@
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 
 #include <algorithm>
 #include <exception>
@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "lidar_lidar_calibrator.hpp"
-#include "rigcal/calib/calibration_budget.hpp"
-#include "rigcal/calib/lidar_lidar_verdict.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 
 namespace rigcal::calib {
 

@@ -4,7 +4,7 @@
 
 #include <sstream>
 
-#include "rigcal/calib/calibration_budget.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
 
 namespace rigcal::calib::detail {
 

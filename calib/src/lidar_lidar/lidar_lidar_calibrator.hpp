@@ -10,8 +10,8 @@
 #include <tuple>
 #include <vector>
 
-#include "rigcal/calib/calibration_score.hpp"
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 
 namespace rigcal::calib::detail {
 

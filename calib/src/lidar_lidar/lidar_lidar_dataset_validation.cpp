@@ -1,7 +1,7 @@
 // What a CalibrationDataset must hold before calibration starts: one clear message for the first gap.
 #include <sstream>
 
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 #include "lidar_lidar_calibrator.hpp"
 
 namespace rigcal::calib {

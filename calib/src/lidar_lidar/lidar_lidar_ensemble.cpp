@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstdint>
 
-#include "rigcal/calib/calibration_deskew.hpp"
-#include "rigcal/calib/calibration_budget.hpp"
-#include "rigcal/calib/calibration_source.hpp"
-#include "rigcal/calib/ensemble_plan.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_deskew.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_source.hpp"
+#include "rigcal/calib/lidar_lidar/ensemble_plan.hpp"
 
 namespace rigcal::calib::detail {
 

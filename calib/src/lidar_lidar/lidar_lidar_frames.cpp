@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <sstream>
 
-#include "rigcal/calib/augmented_target.hpp"
-#include "rigcal/calib/calibration_budget.hpp"
-#include "rigcal/calib/calibration_source.hpp"
+#include "rigcal/calib/lidar_lidar/augmented_target.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_source.hpp"
 
 namespace rigcal::calib::detail {
 

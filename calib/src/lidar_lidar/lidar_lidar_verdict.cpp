@@ -1,4 +1,4 @@
-#include "rigcal/calib/lidar_lidar_verdict.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 
 #include <algorithm>
 #include <cmath>

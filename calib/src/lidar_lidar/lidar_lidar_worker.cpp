@@ -1,4 +1,4 @@
-#include "rigcal/calib/lidar_lidar_worker.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_worker.hpp"
 
 #include <chrono>
 

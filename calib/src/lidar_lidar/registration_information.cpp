@@ -1,4 +1,4 @@
-#include "rigcal/calib/registration_information.hpp"
+#include "rigcal/calib/lidar_lidar/registration_information.hpp"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,4 +1,4 @@
-#include "rigcal/calib/lidar_pose_calibration.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_calibration.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -8,7 +8,7 @@
 
 #include <nlopt.hpp>
 
-#include "rigcal/calib/lidar_pose_objective.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_objective.hpp"
 
 namespace rigcal::calib {
 namespace {

@@ -1,15 +1,11 @@
-#include "rigcal/calib/lidar_pose_objective.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_objective.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <condition_variable>
-#include <functional>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 
 namespace rigcal::calib {
@@ -28,74 +24,13 @@ inline std::int64_t fastFloor(float v) {
 }
 }  // namespace
 
-// n − 1 helper threads that sleep on a condition variable between jobs (no spinning on a 2-core
-// target); the caller runs part 0 itself.
-class LidarPoseObjective::Workers {
- public:
-  explicit Workers(int threads) {
-    for (int part = 1; part < threads; ++part) threads_.emplace_back([this, part] { loop(part); });
-  }
-  ~Workers() {
-    {
-      std::lock_guard lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    for (auto& t : threads_) t.join();
-  }
-
-  void run(const std::function<void(int)>& task) {
-    if (threads_.empty()) {
-      task(0);
-      return;
-    }
-    {
-      std::lock_guard lock(mutex_);
-      task_ = &task;
-      pending_ = threads_.size();
-      ++generation_;
-    }
-    wake_.notify_all();
-    task(0);
-    std::unique_lock lock(mutex_);
-    done_.wait(lock, [this] { return pending_ == 0; });
-    task_ = nullptr;
-  }
-
- private:
-  void loop(int part) {
-    std::uint64_t seen = 0;
-    while (true) {
-      const std::function<void(int)>* task = nullptr;
-      {
-        std::unique_lock lock(mutex_);
-        wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
-        if (stop_) return;
-        seen = generation_;
-        task = task_;
-      }
-      (*task)(part);
-      std::lock_guard lock(mutex_);
-      if (--pending_ == 0) done_.notify_one();
-    }
-  }
-
-  std::vector<std::thread> threads_;
-  std::mutex mutex_;
-  std::condition_variable wake_, done_;
-  const std::function<void(int)>* task_ = nullptr;
-  std::size_t pending_ = 0;
-  std::uint64_t generation_ = 0;
-  bool stop_ = false;
-};
-
 LidarPoseObjective::LidarPoseObjective(const LidarPoints& points, const PoseTrajectory& trajectory,
                                        int threads)
-    : points_(points), trajectory_(trajectory), n_(points.size()), threads_(std::max(1, threads)) {
+    : points_(points), trajectory_(trajectory), n_(points.size()), threads_(std::max(1, threads)),
+      workers_(threads_) {
   if (n_ < 2) throw std::invalid_argument("LidarPoseObjective: needs at least 2 points");
   if (n_ > std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("LidarPoseObjective: too many points");
-  workers_ = std::make_unique<Workers>(threads_);
   pose_cache_.resize(12 * n_);
   pose_missing_.resize(threads_);
   wx_.resize(n_);
@@ -123,7 +58,7 @@ std::pair<std::size_t, std::size_t> LidarPoseObjective::pointRange(int part) con
 void LidarPoseObjective::updatePoses(double time_offset_s) {
   if (poses_valid_ && time_offset_s == pose_offset_) return;
   std::fill(pose_missing_.begin(), pose_missing_.end(), 0);
-  workers_->run([&](int part) {
+  forEachPart([&](int part) {
     const auto [begin, end] = pointRange(part);
     std::size_t hint = 0;
     for (std::size_t i = begin; i < end; ++i) {
@@ -207,7 +142,7 @@ void LidarPoseObjective::sortByCell() {
   int bits = 1;
   while (bits < 64 && (std::uint64_t{1} << bits) < static_cast<std::uint64_t>(cells)) ++bits;
 
-  workers_->run([&](int part) {
+  forEachPart([&](int part) {
     const auto [begin, end] = pointRange(part);
     for (std::size_t i = begin; i < end; ++i) {
       const auto qx = fastFloor(wx_[i] * inv_quantum_) - origin_[0];
@@ -236,7 +171,7 @@ void LidarPoseObjective::sortByCell() {
     keys_.swap(keys_tmp_);
     order_.swap(order_tmp_);
   }
-  workers_->run([&](int part) {
+  forEachPart([&](int part) {
     const auto [begin, end] = pointRange(part);
     for (std::size_t k = begin; k < end; ++k) {
       const std::uint32_t i = order_[k];
@@ -359,9 +294,9 @@ double LidarPoseObjective::evaluate(const Pose& T_pose_lidar, double time_offset
   // keeps that window well under the warm-started bound; 256 still fits 3 radix passes here.
   quantum_ = radius / static_cast<float>(kQuantaPerRadius);
   inv_quantum_ = 1.0f / quantum_;
-  workers_->run([&](int part) { transform(part, T_pose_lidar); });
+  forEachPart([&](int part) { transform(part, T_pose_lidar); });
   sortByCell();
-  workers_->run([&](int part) { sweep(part); });
+  forEachPart([&](int part) { sweep(part); });
   // Fixed-order reduction: the same sum for any thread count.
   double total = 0.0;
   for (const float c : cost_) total += static_cast<double>(c);

@@ -1,4 +1,4 @@
-#include "rigcal/calib/lidar_pose_observability.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_observability.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,5 @@
-#include "rigcal/calib/lidar_pose_output.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_output.hpp"
 
-#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -71,26 +70,6 @@ std::string lidarPoseCalibrationText(const LidarPoseResult& r, const Eigen::Vect
 void writeLidarPoseCalibrationText(const std::filesystem::path& path, const LidarPoseResult& result,
                                    const Eigen::Vector3d& origin) {
   writeText(path, lidarPoseCalibrationText(result, origin));
-}
-
-void writeLidarPoseYaml(const std::filesystem::path& path, const LidarPoseResult& r,
-                        const std::string& parent_frame, const std::string& child_frame) {
-  const XyzRpy v = toXyzRpy(r.T_pose_lidar);
-  std::string flagged;
-  for (std::size_t i = 0; i < kLidarPoseParams; ++i)
-    if (r.observability.poorly_constrained[i])
-      flagged += std::string(flagged.empty() ? "" : ", ") + lidarPoseParamName(static_cast<LidarPoseParam>(i));
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "# rigcal calibrate-pose: T_%s_%s (maps %s points into the %s frame)\n"
-                "# poorly constrained by the motion%s: %s\n"
-                "%s:\n  %s:\n    x: %.6f\n    y: %.6f\n    z: %.6f\n    roll: %.6f\n    pitch: %.6f\n"
-                "    yaw: %.6f\n    time_offset_s: %.9f\n",
-                parent_frame.c_str(), child_frame.c_str(), child_frame.c_str(), parent_frame.c_str(),
-                flagged.empty() ? "" : " (held at the initial guess unless disabled)",
-                flagged.empty() ? "none" : flagged.c_str(), parent_frame.c_str(), child_frame.c_str(), v.x,
-                v.y, v.z, v.roll, v.pitch, v.yaw, r.time_offset_s);
-  writeText(path, buf);
 }
 
 void writeLidarPoseCloud(const std::filesystem::path& path, const LidarPoints& points,

@@ -1,4 +1,4 @@
-#include "rigcal/calib/lidar_pose_points.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_points.hpp"
 
 #include <algorithm>
 #include <cinttypes>

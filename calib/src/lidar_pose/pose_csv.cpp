@@ -1,4 +1,4 @@
-#include "rigcal/calib/pose_csv.hpp"
+#include "rigcal/calib/lidar_pose/pose_csv.hpp"
 
 #include <array>
 #include <charconv>

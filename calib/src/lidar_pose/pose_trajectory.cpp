@@ -1,11 +1,11 @@
-#include "rigcal/calib/pose_trajectory.hpp"
+#include "rigcal/calib/lidar_pose/pose_trajectory.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "rigcal/calib/pose_csv.hpp"
+#include "rigcal/calib/lidar_pose/pose_csv.hpp"
 
 namespace rigcal::calib {
 namespace {

@@ -1,4 +1,4 @@
-#include "rigcal/calib/calibration_outcome.hpp"
+#include "rigcal/calib/outputs/calibration_outcome.hpp"
 
 namespace rigcal::calib {
 

@@ -1,4 +1,4 @@
-#include "rigcal/calib/calibration_yaml_writer.hpp"
+#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
 #include "rigcal/core/atomic_file.hpp"
 
 #include <fstream>
@@ -74,6 +74,27 @@ std::string calibrationYaml(const CalibrationOutcome& o) {
 
 void writeCalibrationYaml(const std::filesystem::path& path, const CalibrationOutcome& outcome) {
   writeFileAtomically(path, [&](std::ostream& out) { out << calibrationYaml(outcome); });
+}
+
+std::string lidarPoseYaml(const LidarPoseResult& r, const std::string& parent_frame, const std::string& child_frame) {
+  std::string flagged;
+  for (std::size_t i = 0; i < kLidarPoseParams; ++i)
+    if (r.observability.poorly_constrained[i])
+      flagged += std::string(flagged.empty() ? "" : ", ") + lidarPoseParamName(static_cast<LidarPoseParam>(i));
+  std::ostringstream out;
+  out << "# rigcal calibrate-pose: T_" << parent_frame << "_" << child_frame << " (maps " << child_frame
+      << " points into the " << parent_frame << " frame)\n"
+      << "# poorly constrained by the motion" << (flagged.empty() ? "" : " (held at the initial guess unless disabled)")
+      << ": " << (flagged.empty() ? "none" : flagged) << "\n"
+      << parent_frame << ":\n  " << child_frame << ":\n";
+  writeXyzRpy(out, "    ", r.T_pose_lidar);
+  out << std::setprecision(9) << "    time_offset_s: " << r.time_offset_s << "\n";
+  return out.str();
+}
+
+void writeLidarPoseYaml(const std::filesystem::path& path, const LidarPoseResult& result,
+                        const std::string& parent_frame, const std::string& child_frame) {
+  writeFileAtomically(path, [&](std::ostream& out) { out << lidarPoseYaml(result, parent_frame, child_frame); });
 }
 
 }  // namespace rigcal::calib

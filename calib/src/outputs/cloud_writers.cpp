@@ -1,4 +1,4 @@
-#include "rigcal/calib/cloud_writers.hpp"
+#include "rigcal/calib/outputs/cloud_writers.hpp"
 
 #include <set>
 

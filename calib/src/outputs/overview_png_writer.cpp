@@ -1,4 +1,4 @@
-#include "rigcal/calib/overview_png_writer.hpp"
+#include "rigcal/calib/outputs/overview_png_writer.hpp"
 
 #include <png.h>
 
@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "rigcal/calib/cloud_writers.hpp"
+#include "rigcal/calib/outputs/cloud_writers.hpp"
 #include "rigcal/core/atomic_file.hpp"
 
 namespace rigcal::calib {

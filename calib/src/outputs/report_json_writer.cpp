@@ -1,4 +1,4 @@
-#include "rigcal/calib/report_json_writer.hpp"
+#include "rigcal/calib/outputs/report_json_writer.hpp"
 #include "rigcal/core/atomic_file.hpp"
 
 #include <fstream>

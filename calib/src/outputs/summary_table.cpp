@@ -1,4 +1,4 @@
-#include "rigcal/calib/summary_table.hpp"
+#include "rigcal/calib/outputs/summary_table.hpp"
 
 #include <cstdio>
 #include <sstream>

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "rigcal/calib/ground_plane.hpp"
+#include "rigcal/calib/base_lidar/ground_plane.hpp"
 #include "rigcal/config/parameters.hpp"
 #include "rigcal/core/pose.hpp"
 

@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "rigcal/calib/base_lidar_calibration.hpp"
+#include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
 #include "rigcal/config/parameters.hpp"
 #include "rigcal/core/pose.hpp"
 

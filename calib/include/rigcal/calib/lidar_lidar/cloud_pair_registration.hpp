@@ -8,9 +8,9 @@
 #include <optional>
 #include <string>
 
-#include "rigcal/calib/cloud_pair_global_search.hpp"
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
-#include "rigcal/calib/registration_information.hpp"
+#include "rigcal/calib/lidar_lidar/cloud_pair_global_search.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/registration_information.hpp"
 #include "rigcal/config/parameters.hpp"
 #include "rigcal/core/pose.hpp"
 #include "rigcal/core/scan.hpp"

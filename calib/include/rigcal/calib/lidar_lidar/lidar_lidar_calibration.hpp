@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "rigcal/calib/augmented_target.hpp"
-#include "rigcal/calib/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar/augmented_target.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_score.hpp"
 #include "rigcal/config/parameters.hpp"
 #include "rigcal/core/pose.hpp"
 #include "rigcal/pipeline/calibration_dataset.hpp"

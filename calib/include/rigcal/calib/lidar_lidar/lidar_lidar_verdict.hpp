@@ -8,7 +8,7 @@
 // `--deadline` that would do when the deadline cut the plan).
 #include <cstddef>
 
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 
 namespace rigcal::calib {
 

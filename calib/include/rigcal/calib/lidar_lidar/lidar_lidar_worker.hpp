@@ -13,8 +13,8 @@
 #include <thread>
 #include <vector>
 
-#include "rigcal/calib/calibration_budget.hpp"
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 
 namespace rigcal::calib {
 

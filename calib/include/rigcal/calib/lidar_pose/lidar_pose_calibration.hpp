@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "rigcal/calib/lidar_pose_observability.hpp"
-#include "rigcal/calib/lidar_pose_points.hpp"
-#include "rigcal/calib/pose_trajectory.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_observability.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_points.hpp"
+#include "rigcal/calib/lidar_pose/pose_trajectory.hpp"
 #include "rigcal/core/pose.hpp"
 #include "rigcal/core/scan.hpp"
 

@@ -15,12 +15,12 @@
 // threads and reduced in a fixed order, so the result is bit-identical for any thread count and run.
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <vector>
 
-#include "rigcal/calib/lidar_pose_points.hpp"
-#include "rigcal/calib/pose_trajectory.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_points.hpp"
+#include "rigcal/calib/lidar_pose/pose_trajectory.hpp"
 #include "rigcal/core/pose.hpp"
+#include "rigcal/core/worker_pool.hpp"
 
 namespace rigcal::calib {
 
@@ -47,7 +47,12 @@ class LidarPoseObjective {
   [[nodiscard]] std::size_t evaluations() const { return evaluations_; }
 
  private:
-  class Workers;
+  /// fn(part) for each of the threads_ parts of the points, on the pool (each part's outputs are its own).
+  template <class Fn>
+  void forEachPart(const Fn& fn) {
+    workers_.parallelFor(static_cast<std::size_t>(threads_),
+                         [&](std::size_t part) { fn(static_cast<int>(part)); });
+  }
   void updatePoses(double time_offset_s);
   void transform(int part, const Pose& T_pose_lidar);
   void sortByCell();
@@ -58,7 +63,7 @@ class LidarPoseObjective {
   const PoseTrajectory& trajectory_;
   std::size_t n_;
   int threads_;
-  std::unique_ptr<Workers> workers_;
+  WorkerPool workers_;
   std::size_t evaluations_ = 0;
 
   // T_world_pose(t_i + offset) per point, row-major R then t; valid for `pose_offset_`.

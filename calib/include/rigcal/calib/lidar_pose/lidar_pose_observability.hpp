@@ -22,7 +22,7 @@
 #include <array>
 #include <string>
 
-#include "rigcal/calib/pose_trajectory.hpp"
+#include "rigcal/calib/lidar_pose/pose_trajectory.hpp"
 #include "rigcal/core/time.hpp"
 
 namespace rigcal::calib {

@@ -1,7 +1,8 @@
 #pragma once
 // What `rigcal calibrate-pose` writes: lidar_align's calibration text (same sections, so its users
 // and their scripts find what they expect) followed by our observability report, a calibration.yaml in
-// the rig's parent/child x y z roll pitch yaw layout plus the time offset, and the fused cloud as a
+// the rig's parent/child x y z roll pitch yaw layout plus the time offset (calibration_yaml_writer.hpp, the
+// one YAML writer), and the fused cloud as a
 // binary PLY with real intensity and a separate time field (lidar_align stored point times in the
 // intensity field).
 #include <filesystem>
@@ -9,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "rigcal/calib/lidar_pose_calibration.hpp"
+#include "rigcal/calib/lidar_pose/lidar_pose_calibration.hpp"
 
 namespace rigcal::calib {
 
@@ -21,12 +22,6 @@ std::string lidarPoseCalibrationText(const LidarPoseResult& result,
                                      const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
 void writeLidarPoseCalibrationText(const std::filesystem::path& path, const LidarPoseResult& result,
                                    const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
-
-/// parent_frame: { child_frame: { x, y, z, roll, pitch, yaw, time_offset_s } } (6 decimals, time 9),
-/// poorly constrained parameters listed in a comment.
-void writeLidarPoseYaml(const std::filesystem::path& path, const LidarPoseResult& result,
-                        const std::string& parent_frame = "pose_sensor",
-                        const std::string& child_frame = "lidar");
 
 /// The returns used, fused with the result: x y z (float, world frame as read, i.e. re-centred),
 /// intensity (float, as decoded) and time (double, seconds: lidar time + time offset, the pose

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "rigcal/calib/pose_trajectory.hpp"
+#include "rigcal/calib/lidar_pose/pose_trajectory.hpp"
 #include "rigcal/core/scan.hpp"
 #include "rigcal/core/time.hpp"
 

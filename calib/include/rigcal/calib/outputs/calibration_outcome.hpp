@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "rigcal/calib/base_from_motion.hpp"
-#include "rigcal/calib/base_lidar_calibration.hpp"
-#include "rigcal/calib/lidar_lidar_calibration.hpp"
+#include "rigcal/calib/base_lidar/base_from_motion.hpp"
+#include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 #include "rigcal/core/pose.hpp"
 #include "rigcal/core/scan.hpp"
 #include "rigcal/pipeline/calibration_dataset.hpp"

@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-#include "rigcal/calib/calibration_outcome.hpp"
+#include "rigcal/calib/outputs/calibration_outcome.hpp"
 #include "rigcal/core/pose.hpp"
 #include "rigcal/pipeline/calibration_dataset.hpp"
 

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "rigcal/calib/calibration_outcome.hpp"
+#include "rigcal/calib/outputs/calibration_outcome.hpp"
 
 namespace rigcal::calib {
 

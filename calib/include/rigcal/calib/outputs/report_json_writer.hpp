@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rigcal/calib/calibration_outcome.hpp"
+#include "rigcal/calib/outputs/calibration_outcome.hpp"
 
 namespace rigcal::calib {
 

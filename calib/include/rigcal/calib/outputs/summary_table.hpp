@@ -3,7 +3,7 @@
 // yaw of T_parent_child), the change from the initial guess, the score and the frames used.
 #include <string>
 
-#include "rigcal/calib/calibration_outcome.hpp"
+#include "rigcal/calib/outputs/calibration_outcome.hpp"
 
 namespace rigcal::calib {
 
