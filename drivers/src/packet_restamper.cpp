@@ -7,6 +7,7 @@
 
 #include "rigcal/core/civil_date.hpp"
 #include "rigcal/drivers/hesai/hesai_packet.hpp"
+#include "rigcal/drivers/hesai/hesai_crc.hpp"
 #include "rigcal/drivers/ouster/ouster_decoder.hpp"
 #include "rigcal/drivers/ouster/ouster_metadata.hpp"
 #include "rigcal/drivers/ouster/ouster_packet_format.hpp"

@@ -1,4 +1,5 @@
 #include "rigcal/drivers/hesai/hesai_decoder.hpp"
+#include "rigcal/drivers/hesai/hesai_firing_times.hpp"
 
 #include <algorithm>
 #include <cmath>

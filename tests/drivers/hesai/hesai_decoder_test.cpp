@@ -7,6 +7,7 @@
 
 #include "hesai_test_util.hpp"
 #include "rigcal/drivers/hesai/hesai_decoder.hpp"
+#include "rigcal/drivers/hesai/hesai_firing_times.hpp"
 #include "test_data.hpp"
 
 namespace rigcal::drivers {

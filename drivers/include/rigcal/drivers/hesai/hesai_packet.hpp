@@ -1,8 +1,9 @@
 #pragma once
 // Hesai point-cloud packet formats: PandarXT16 / PandarXT32 / PandarXT32M (UDP protocol 6.1),
 // PandarQT128 (QT128C2X, protocol 3.2), PandarQT64 (protocol 3.1), Pandar64 and Pandar40P (the
-// older formats without a protocol version). Layouts, validation and the per-model laser firing
-// times; no decoding into points (hesai_decoder.cpp does that). All multi-byte fields are little endian.
+// older formats without a protocol version). Layouts and validation; the firing times are in
+// hesai_firing_times.hpp, the packet CRC in hesai_crc.hpp, the decoding into points in hesai_decoder.hpp.
+// All multi-byte fields are little endian.
 //
 // Protocol 6.1 (XT16: 568 bytes, XT32: 1080 bytes):
 //   header 12 | 8 blocks × (azimuth u16 + channels × (distance u16, reflectivity u8, reserved u8)) |
@@ -107,25 +108,6 @@ std::string parsePacket(const ModelSpec& spec, std::span<const std::uint8_t> pay
 /// True for Hesai GPS/PPS packets (512 bytes starting 0xFF 0xEE) that may share the data port.
 bool isGpsPacket(std::span<const std::uint8_t> payload);
 
-/// Firing time (ns) of `channel` (0-based) in `block` (0-based) relative to the packet's absolute
-/// time t0 (tail date + µs timestamp), from the Hesai user manuals (Appendix "Absolute Time and
-/// Laser Firing Time"):
-///  XT16/XT32: block start = t0 + 5.632 µs − 50 µs × (firings after this block's firing);
-///             channel offset = 0.368 µs + 1.512 µs × channel (XT32), 3.024 µs × channel (XT16).
-///  QT128:     block start = t0 + 9 µs (dual: both blocks; single: block 2, block 1 is one firing
-///             round, 111.11 µs, earlier); channel offset from the firing sequence table (loop 1 or
-///             2: single → block 1 uses loop 1, block 2 loop 2; dual → loop 1 when mode_flag bit 0).
-///  XT32M:     as XT32 with 6 blocks; channels c and c + 16 fire together, 0.368 + 2.888 µs × (c mod 16).
-///  Pandar40P: block start = t0 − 28.58 µs − 55.56 µs × (firings after); Pandar64: t0 − 42.58 µs −
-///             55.56 µs × (firings after); channel offsets from the manuals' firing-time tables.
-///  QT64:      block start = t0 + 25.71 µs + 166.67 µs × (firing index in the packet); channel
-///             offsets from the QT64 firing-time table.
-/// Channels that do not fire in the chosen loop get the block start (their distance is 0 anyway).
-std::int64_t firingOffsetNs(Model model, int returns, int block, int channel, std::uint8_t mode_flag);
-
-/// The QT128 firing-sequence offset (ns) of `channel` in loop 1 or 2; 0 = does not fire there.
-std::int32_t qt128LoopOffsetNs(int loop, int channel);
-
 /// Seconds since the UNIX epoch of the tail date (year − year_base, month, day, hour, minute,
 /// second), independent of the local time zone; nullopt when a field is out of range.
 std::optional<std::int64_t> utcSeconds(const std::array<std::uint8_t, 6>& date, int year_base = 1900);
@@ -138,8 +120,5 @@ int yearBase(const ModelSpec& spec, std::uint8_t year_byte);
 /// Where the tail date (6 bytes) and the µs timestamp (u32) start in the tail of `spec`'s packets.
 std::size_t tailDateOffset(const ModelSpec& spec);
 std::size_t tailTimestampOffset(const ModelSpec& spec);
-
-/// CRC-32/MPEG-2 (poly 0x04C11DB7, init 0xFFFFFFFF, no reflection, no final xor).
-std::uint32_t crc32Mpeg2(std::span<const std::uint8_t> bytes);
 
 }  // namespace rigcal::drivers::hesai
