@@ -9,6 +9,7 @@
 // Reversing and stops (Release): x error −0.8 mm (σ 5.0 mm), yaw error −0.004° (σ 0.030°), 5.5 m of the 6.2 m
 // backwards used, no frame lost; sim 7 s, calibrate 15 s CPU.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -49,40 +50,59 @@ Truth offsetGuess(const std::filesystem::path& sim) {
   return t;
 }
 
-TEST(BaseFromMotionCli, TurnsBothWaysGiveYawAndX) {
-  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation and calibration of a drive: Release only";
-  TempDir dir;
-  const auto sim = dir / "sim", out = dir / "out";
-  ASSERT_NO_FATAL_FAILURE(simulate("base-motion", sim));
-  const Truth truth = offsetGuess(sim);
-  const auto calibrated = runRigcal(calibrateArgs(sim, out));
-  std::printf("%s", calibrated.out.c_str());
-  ASSERT_EQ(calibrated.exit_code, 0) << calibrated.out << calibrated.err;
-  const auto report = readJson(out / "report.json");
-  const auto& base = report["base_lidar"];
+/// What a calibration of the simulated drive gave, from the guess offsetGuess() set.
+struct MotionRun {
+  Truth truth;
+  CommandResult calibrated;
+  nlohmann::json report;
+};
+
+/// Sets the guess off (offsetGuess), runs `rigcal calibrate` on `sim` into `out`, expects success.
+void calibrateFromOffsetGuess(const std::filesystem::path& sim, const std::filesystem::path& out, MotionRun& run) {
+  run.truth = offsetGuess(sim);
+  run.calibrated = runRigcal(calibrateArgs(sim, out));
+  std::printf("%s", run.calibrated.out.c_str());
+  ASSERT_EQ(run.calibrated.exit_code, 0) << run.calibrated.out << run.calibrated.err;
+  run.report = readJson(out / "report.json");
+}
+
+/// Yaw within 0.1° and x within 5 cm, both from the motion, with turns of more than 45° each way.
+void expectYawAndXFromMotion(const MotionRun& run, const char* what) {
+  const auto& base = run.report["base_lidar"];
   ASSERT_TRUE(base.contains("motion")) << base.dump(2);
   const auto& m = base["motion"];
   ASSERT_TRUE(m["yaw_deg"]["estimated"].get<bool>()) << m.dump(2);
   ASSERT_TRUE(m["x_m"]["estimated"].get<bool>()) << m.dump(2);
-  const double yaw_err = m["yaw_deg"]["value"].get<double>() - truth.yaw / kDeg;
-  const double x_err = m["x_m"]["value"].get<double>() - truth.x;
-  std::printf("from 0.3 m / 5 deg off: yaw error %.4f deg (std %.4f), x error %.4f m (std %.4f)\n", yaw_err,
-              m["yaw_deg"]["stddev"].get<double>(), x_err, m["x_m"]["stddev"].get<double>());
+  const double yaw_err = m["yaw_deg"]["value"].get<double>() - run.truth.yaw / kDeg;
+  const double x_err = m["x_m"]["value"].get<double>() - run.truth.x;
+  std::printf("%s, from 0.3 m / 5 deg off: yaw error %.4f deg (std %.4f), x error %.4f m (std %.4f)\n", what,
+              yaw_err, m["yaw_deg"]["stddev"].get<double>(), x_err, m["x_m"]["stddev"].get<double>());
   EXPECT_LT(std::abs(yaw_err), 0.1);
   EXPECT_LT(std::abs(x_err), 0.05);
   EXPECT_GT(m["left_turn_deg"].get<double>(), 45.0);
   EXPECT_GT(m["right_turn_deg"].get<double>(), 45.0);
   EXPECT_EQ(base["sources"]["x"], "motion");
   EXPECT_EQ(base["sources"]["yaw"], "motion");
+  EXPECT_NEAR(run.report["T_base_sensor"]["top"]["x"].get<double>(), run.truth.x, 0.05);
+  EXPECT_NEAR(run.report["T_base_sensor"]["top"]["yaw"].get<double>(), run.truth.yaw, 0.1 * kDeg);
+}
+
+TEST(BaseFromMotionCli, TurnsBothWaysGiveYawAndX) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation and calibration of a drive: Release only";
+  TempDir dir;
+  const auto sim = dir / "sim", out = dir / "out";
+  ASSERT_NO_FATAL_FAILURE(simulate("base-motion", sim));
+  MotionRun run;
+  ASSERT_NO_FATAL_FAILURE(calibrateFromOffsetGuess(sim, out, run));
+  expectYawAndXFromMotion(run, "turns both ways");
+  const auto& base = run.report["base_lidar"];
   EXPECT_EQ(base["sources"]["y"], "guess");
   EXPECT_EQ(base["sources"]["z"], "ground");
-  // The written result is the motion's: report.json's T_base_sensor and calibration.yaml agree with it.
-  EXPECT_NEAR(report["T_base_sensor"]["top"]["x"].get<double>(), truth.x, 0.05);
-  EXPECT_NEAR(report["T_base_sensor"]["top"]["yaw"].get<double>(), truth.yaw, 0.1 * kDeg);
   EXPECT_NE(readText(out / "calibration.yaml").find("top"), std::string::npos);
-  EXPECT_NE(calibrated.out.find("z, roll, pitch from the ground"), std::string::npos) << calibrated.out;
-  EXPECT_NE(calibrated.out.find("from motion"), std::string::npos) << calibrated.out;
-  EXPECT_NE(calibrated.out.find("y from the guess"), std::string::npos) << calibrated.out;
+  const std::string& printed = run.calibrated.out;
+  EXPECT_NE(printed.find("z, roll, pitch from the ground"), std::string::npos) << printed;
+  EXPECT_NE(printed.find("from motion"), std::string::npos) << printed;
+  EXPECT_NE(printed.find("y from the guess"), std::string::npos) << printed;
 }
 
 TEST(BaseFromMotionCli, StraightDriveGivesYawAndSaysXIsNotObservable) {
@@ -97,14 +117,13 @@ TEST(BaseFromMotionCli, StraightDriveGivesYawAndSaysXIsNotObservable) {
                                            "    base_lidar_min_plane_points: 300\n");
   ASSERT_FALSE(text.empty());
   ASSERT_NO_FATAL_FAILURE(simulateYaml(text, sim));
-  const Truth truth = offsetGuess(sim);
-  const auto calibrated = runRigcal(calibrateArgs(sim, out));
-  std::printf("%s", calibrated.out.c_str());
-  ASSERT_EQ(calibrated.exit_code, 0) << calibrated.out << calibrated.err;
-  const auto report = readJson(out / "report.json");
+  MotionRun run;
+  ASSERT_NO_FATAL_FAILURE(calibrateFromOffsetGuess(sim, out, run));
+  const auto& report = run.report;
+  const auto& calibrated = run.calibrated;
   const auto& m = report["base_lidar"]["motion"];
   ASSERT_TRUE(m["yaw_deg"]["estimated"].get<bool>()) << m.dump(2);
-  const double yaw_err = m["yaw_deg"]["value"].get<double>() - truth.yaw / kDeg;
+  const double yaw_err = m["yaw_deg"]["value"].get<double>() - run.truth.yaw / kDeg;
   std::printf("straight only, from 5 deg off: yaw error %.4f deg (std %.4f), %.1f m straight\n", yaw_err,
               m["yaw_deg"]["stddev"].get<double>(), m["straight_m"].get<double>());
   EXPECT_LT(std::abs(yaw_err), 0.1);
@@ -138,33 +157,15 @@ TEST(BaseFromMotionCli, ReversingAndStopsStillPass) {
                                            "");
   ASSERT_FALSE(text.empty());
   ASSERT_NO_FATAL_FAILURE(simulateYaml(text, sim));
-  const Truth truth = offsetGuess(sim);
-  const auto calibrated = runRigcal(calibrateArgs(sim, out));
-  std::printf("%s", calibrated.out.c_str());
-  ASSERT_EQ(calibrated.exit_code, 0) << calibrated.out << calibrated.err;
-  const auto report = readJson(out / "report.json");
-  EXPECT_EQ(report["input"]["lost_frames"], "0") << "the mapper tracks through the stops and backwards";
-  const auto& base = report["base_lidar"];
-  const auto& m = base["motion"];
-  ASSERT_TRUE(m["yaw_deg"]["estimated"].get<bool>()) << m.dump(2);
-  ASSERT_TRUE(m["x_m"]["estimated"].get<bool>()) << m.dump(2);
-  const double yaw_err = m["yaw_deg"]["value"].get<double>() - truth.yaw / kDeg;
-  const double x_err = m["x_m"]["value"].get<double>() - truth.x;
-  std::printf("reversing %.1f m (%s lost frames), from 0.3 m / 5 deg off: yaw error %.4f deg (std %.4f), x error "
-              "%.4f m (std %.4f)\n",
-              m["reversing_m"].get<double>(), report["input"]["lost_frames"].get<std::string>().c_str(), yaw_err,
-              m["yaw_deg"]["stddev"].get<double>(), x_err, m["x_m"]["stddev"].get<double>());
+  MotionRun run;
+  ASSERT_NO_FATAL_FAILURE(calibrateFromOffsetGuess(sim, out, run));
+  EXPECT_EQ(run.report["input"]["lost_frames"], "0") << "the mapper tracks through the stops and backwards";
+  const auto& m = run.report["base_lidar"]["motion"];
+  std::printf("reversing %.1f m\n", m["reversing_m"].get<double>());
   // The simulator drove 6.2 m backwards; the estimator used the moving, tracked part of it.
   EXPECT_GT(m["reversing_m"].get<double>(), 3.0);
   EXPECT_LT(m["reversing_m"].get<double>(), 6.5);
-  EXPECT_LT(std::abs(yaw_err), 0.1);
-  EXPECT_LT(std::abs(x_err), 0.05);
-  EXPECT_GT(m["left_turn_deg"].get<double>(), 45.0);
-  EXPECT_GT(m["right_turn_deg"].get<double>(), 45.0);
-  EXPECT_EQ(base["sources"]["x"], "motion");
-  EXPECT_EQ(base["sources"]["yaw"], "motion");
-  EXPECT_NEAR(report["T_base_sensor"]["top"]["x"].get<double>(), truth.x, 0.05);
-  EXPECT_NEAR(report["T_base_sensor"]["top"]["yaw"].get<double>(), truth.yaw, 0.1 * kDeg);
+  expectYawAndXFromMotion(run, "reversing and stops");
 }
 
 }  // namespace
