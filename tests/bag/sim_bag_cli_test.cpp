@@ -3,6 +3,7 @@
 // form holds every simulated sweep point for point (against --dump-scans), and both bags carry
 // /tf_static (the rig.yaml initial extrinsics) and /odom (the samples of poses.csv).
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <fstream>
 #include <iterator>
@@ -171,6 +172,28 @@ TEST_F(SimBag, CloudFormHoldsEverySimulatedSweepWithTfStaticAndOdometry) {
   for (std::size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(odometry[i].first, rows[i].first) << i;
     EXPECT_EQ(odometry[i].second, rows[i].second) << i;
+  }
+}
+
+// rig-from-bag on the packet form: every sensor with its model (from the packets) and topic, and the
+// initial extrinsics from /tf_static equal to the sim's rig.yaml.
+TEST_F(SimBag, RigFromBagNamesEverySensorModelTopicAndExtrinsic) {
+  ASSERT_EQ(sim_->exit_code, 0) << sim_->err;
+  const fs::path sim = dir_->path() / "sim";
+  const auto r = runRigcal({"rig-from-bag", (sim / "recording.mcap").string(), "--out", (dir_->path() / "from_bag.yaml").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const YAML::Node got = YAML::LoadFile((dir_->path() / "from_bag.yaml").string());
+  const YAML::Node want = YAML::LoadFile((sim / "rig.yaml").string());
+  ASSERT_EQ(got["sensors"].size(), std::size(kSensors));
+  for (std::size_t i = 0; i < std::size(kSensors); ++i) {
+    const YAML::Node s = got["sensors"][i];
+    const std::string name = s["name"].as<std::string>();
+    EXPECT_EQ(name, kSensors[i].name);
+    EXPECT_EQ(s["model"].as<std::string>(), kSensors[i].model) << name;
+    EXPECT_EQ(s["source"]["topic"].as<std::string>(), "/" + name + "/packets");
+    for (const char* k : {"x", "y", "z", "roll", "pitch", "yaw"})
+      EXPECT_NEAR(got["initial_extrinsics"][name][k].as<double>(), want["initial_extrinsics"][name][k].as<double>(), 2e-6)
+          << name << " " << k;
   }
 }
 
