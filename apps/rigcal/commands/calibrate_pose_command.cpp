@@ -31,7 +31,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct CalibratePoseArgs {
-  std::string pcap, poses, config, sensor, model, calibration, metadata, address, out;
+  std::string pcap, bag, topic, poses, pose_topic, pose_tf, config, sensor, model, calibration, metadata, address, out;
   std::string time_source = "sensor";
   int port = 0;
   std::uint64_t seed = 0;
@@ -72,8 +72,11 @@ Decoded decode(const CalibratePoseArgs& a, const calib::LidarPointSelection& sel
     const std::atomic<bool> stop{false};
     std::unique_ptr<pipeline::SensorDriver> driver;
     try {
-      driver = std::make_unique<pipeline::SensorDriver>(*sensor, pipeline::DriverInput{fs::path(a.pcap), 0.0}, stop,
-                                                        on_scan);
+      pipeline::DriverInput input;
+      if (a.bag.empty()) input.pcap = fs::path(a.pcap);
+      else input.bag = fs::path(a.bag);
+      input.topic = a.topic;
+      driver = std::make_unique<pipeline::SensorDriver>(*sensor, input, stop, on_scan);
     } catch (const std::exception& e) {
       throw CommandFailed(kExitInput, e.what());
     }
