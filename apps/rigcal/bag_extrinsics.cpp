@@ -1,6 +1,7 @@
 #include "bag_extrinsics.hpp"
 
 #include <iostream>
+#include <sstream>
 
 #include "commands.hpp"
 #include "exit_codes.hpp"
@@ -16,6 +17,7 @@ void applyExtrinsicsFromBag(config::RigConfig& rig, const pipeline::PipelineOpti
     throw CommandFailed(kExitUsage, rig.file.string() + ": initial_extrinsics from_bag needs --bag");
   try {
     const bag::TfTree tree = bag::TfTree::fromBag(options.bag);
+    std::string log;  // printed once every sensor's frame is found: an error stays one line
     for (const auto& name : rig.extrinsics_from_bag) {
       const config::SensorConfig& sensor = rig.sensor(name);
       std::string frame = sensor.source.frame.value_or("");
@@ -38,10 +40,13 @@ void applyExtrinsicsFromBag(config::RigConfig& rig, const pipeline::PipelineOpti
       std::string chain;
       for (const auto& f : path) chain += (chain.empty() ? "" : " -> ") + f;
       const XyzRpy v = toXyzRpy(rig.initial_T_base_sensor[name]);
-      std::cerr << "initial extrinsic of '" << name << "' from the bag's tf: " << chain << " (x " << v.x << " y "
+      std::ostringstream line;
+      line << "initial extrinsic of '" << name << "' from the bag's tf: " << chain << " (x " << v.x << " y "
                 << v.y << " z " << v.z << " m, roll " << v.roll << " pitch " << v.pitch << " yaw " << v.yaw
                 << " rad)\n";
+      log += line.str();
     }
+    std::cerr << log;
   } catch (const bag::BagError& e) {
     throw CommandFailed(kExitInput, e.what());
   }
