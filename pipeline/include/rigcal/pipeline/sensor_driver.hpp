@@ -19,6 +19,10 @@
 namespace rigcal::pipeline {
 
 struct DriverInput {
+  DriverInput() = default;
+  /// `{pcap, rate}` as before bags existed (no aggregate: the bag fields need no initializer there).
+  DriverInput(std::optional<std::filesystem::path> pcap_file, double replay_rate)
+      : pcap(std::move(pcap_file)), rate(replay_rate) {}
   std::optional<std::filesystem::path> pcap;  // empty (and no bag): live UDP on the sensor's port
   double rate = 0.0;                          // pcap or bag: 1.0 = recorded timing, 0 = as fast as possible
   std::optional<std::filesystem::path> bag;   // a ROS 2 bag instead of a pcap
