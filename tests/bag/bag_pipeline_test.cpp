@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <unistd.h>
+
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -224,6 +226,31 @@ TEST_F(BagPipeline, BadBagInputIsOneLineWithExitCode4) {
   EXPECT_NE(unnamed.err.find("several lidar topics"), std::string::npos) << unnamed.err;
 }
 
+
+// `rigcal driver --bag`: one sensor's packets or clouds from the bag into its ring, as from the pcap.
+TEST_F(BagPipeline, DriverPublishesTheBagsScansAsThePcaps) {
+  const std::string rig = (g->dir / "rig.yaml").string();
+  const std::string prefix = "rigcal.bagtest" + std::to_string(::getpid()) + ".";
+  const auto published = [](const CommandResult& r) {
+    const auto at = r.out.find(" scans published");
+    const auto from = r.out.rfind(' ', at - 1);
+    return at == std::string::npos ? -1 : std::stoi(r.out.substr(from + 1, at - from - 1));
+  };
+  const auto pcap = runRigcal({"driver", "--config", rig, "--sensor", "front_left", "--pcap", g->pcap.string(),
+                               "--rate", "max", "--shm-prefix", prefix});
+  ASSERT_EQ(pcap.exit_code, 0) << pcap.err;
+  const auto packets = runRigcal({"driver", "--config", rig, "--sensor", "front_left", "--bag", g->packets_bag.string(),
+                                  "--topic", topicOf("front_left", "packets"), "--rate", "max", "--shm-prefix", prefix});
+  ASSERT_EQ(packets.exit_code, 0) << packets.err;
+  EXPECT_NE(packets.out.find("reading bag topic /sensing/lidar/front_left/packets (nebula_msgs/msg/NebulaPackets)"),
+            std::string::npos) << packets.out;
+  const auto clouds = runRigcal({"driver", "--config", rig, "--sensor", "front_left", "--bag", g->clouds_bag.string(),
+                                 "--topic", topicOf("front_left", "points"), "--rate", "max", "--shm-prefix", prefix});
+  ASSERT_EQ(clouds.exit_code, 0) << clouds.err;
+  ASSERT_GT(published(pcap), 3);
+  EXPECT_EQ(published(packets), published(pcap)) << packets.out;
+  EXPECT_EQ(published(clouds), int(g->clouds["front_left"])) << clouds.out;
+}
 
 /// poses.csv rows (timestamp_ns, index, px py pz, qw qx qy qz) as nav_msgs/Odometry and as /tf map ->
 /// base_link, the values copied exactly (the bag holds what the CSV holds).

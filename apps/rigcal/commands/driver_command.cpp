@@ -109,6 +109,7 @@ void run(const DriverOptions& o) {
             << o.slots << " slots, " << mebibytes(shm::ringBytes(o.slots, std::uint32_t(driver->maxPointsPerScan())))
             << " MiB)"
             << (ring->tookOver() ? " (took over a stale ring)" : "") << std::endl;
+  if (!driver->bagTopic().empty()) std::cout << "reading bag topic " << driver->bagTopic() << std::endl;
 
   driver->run([&] { ring->heartbeat(); });
 
