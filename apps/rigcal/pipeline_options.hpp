@@ -3,6 +3,7 @@
 // the input (--pcap F [--rate R] | --live | --shm), real time or offline, pinning, and the stats output.
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "rigcal/pipeline/pipeline.hpp"
 
@@ -10,6 +11,8 @@ namespace rigcal::app {
 
 struct PipelineCliOptions {
   std::string pcap;
+  std::string bag;                  // a ROS 2 bag (folder, .mcap or .db3) instead of a pcap
+  std::vector<std::string> topics;  // with --bag: SENSOR=TOPIC (or TOPIC for a one-sensor rig)
   std::string rate;       // empty: as fast as possible (offline); "1" = recorded timing (real time)
   bool live = false;
   bool shm = false;
@@ -21,7 +24,7 @@ struct PipelineCliOptions {
   std::string stats_file;
 };
 
-/// Adds --pcap --rate --live --shm --shm-prefix --realtime --pin --cores --stats to `cmd`.
+/// Adds --pcap --bag --topic --rate --live --shm --shm-prefix --realtime --pin --cores --stats to `cmd`.
 void addPipelineOptions(CLI::App& cmd, PipelineCliOptions& o);
 
 /// Throws CommandFailed(kExitUsage) on a bad combination or value (one line, naming the option).

@@ -166,11 +166,17 @@ SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
 
   const YAML::Node src = r.required(n, "source", "sensor '" + s.name + "'");
   r.requireMap(src, "source");
-  r.checkKeys(src, {"port", "address", "multicast_group", "bind", "info_port"}, "source of sensor '" + s.name + "'");
-  const YAML::Node port = r.required(src, "port", "source of sensor '" + s.name + "'");
-  const long long p = r.integer(port, "port");
-  r.inRange(port, "port", double(p), 1, 65535);
-  s.source.port = std::uint16_t(p);
+  r.checkKeys(src, {"port", "address", "multicast_group", "bind", "info_port", "topic", "frame"},
+              "source of sensor '" + s.name + "'");
+  if (src["topic"]) s.source.topic = r.text(src["topic"], "topic");
+  if (src["frame"]) s.source.frame = r.text(src["frame"], "frame");
+  // A bag topic alone is a complete source (bag input only); otherwise the UDP port is required.
+  if (!s.source.topic || src["port"]) {
+    const YAML::Node port = r.required(src, "port", "source of sensor '" + s.name + "' (or a bag 'topic')");
+    const long long p = r.integer(port, "port");
+    r.inRange(port, "port", double(p), 1, 65535);
+    s.source.port = std::uint16_t(p);
+  }
   if (src["address"]) s.source.address = r.ipv4(src["address"], "address");
   if (src["multicast_group"]) s.source.multicast_group = r.ipv4(src["multicast_group"], "multicast_group", true);
   if (src["bind"]) s.source.bind = r.ipv4(src["bind"], "bind");
@@ -291,6 +297,7 @@ void checkDistinctSources(const Reader& r, const YAML::Node& nodes, const std::v
   for (std::size_t j = 0; j < sensors.size(); ++j)
     for (std::size_t i = 0; i < j; ++i) {
       const SensorSource &a = sensors[i].source, &b = sensors[j].source;
+      if (a.port == 0 || b.port == 0) continue;  // bag-topic-only sensors: no port to share
       // On a loopback bind the address filter is off: then only the port tells sensors apart.
       const bool filtered = !a.bindsLoopback() && !b.bindsLoopback();
       if (a.port != b.port || (filtered && a.address && b.address && *a.address != *b.address)) continue;
@@ -391,11 +398,22 @@ RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
 
   for (const auto& s : rig.sensors) rig.initial_T_base_sensor[s.name] = Pose::Identity();
   if (const YAML::Node ex = root["initial_extrinsics"]) {
-    r.requireMap(ex, "initial_extrinsics");
-    for (const auto& kv : ex) {
-      const std::string name = kv.first.as<std::string>();
-      requireSensor(kv.first, name);
-      rig.initial_T_base_sensor[name] = readExtrinsic(r, kv.second, name);
+    // `from_bag`: every sensor's from the bag's tf tree; per sensor, `name: from_bag` likewise.
+    if (ex.IsScalar()) {
+      if (ex.Scalar() != kExtrinsicsFromBag)
+        r.fail(ex, "'initial_extrinsics' must be a mapping of sensor names or '" + std::string(kExtrinsicsFromBag) +
+                       "', got '" + ex.Scalar() + "'");
+      for (const auto& s : rig.sensors) rig.extrinsics_from_bag.push_back(s.name);
+    } else {
+      r.requireMap(ex, "initial_extrinsics");
+      for (const auto& kv : ex) {
+        const std::string name = kv.first.as<std::string>();
+        requireSensor(kv.first, name);
+        if (kv.second.IsScalar() && kv.second.Scalar() == kExtrinsicsFromBag)
+          rig.extrinsics_from_bag.push_back(name);
+        else
+          rig.initial_T_base_sensor[name] = readExtrinsic(r, kv.second, name);
+      }
     }
   }
 

@@ -2,6 +2,7 @@
 // driver threads (pcap / live UDP through SensorDriver) and the shared-memory ring readers.
 #include "pipeline_impl.hpp"
 
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 
@@ -43,15 +44,22 @@ void Pipeline::Impl::mappingIngested(TimeNs stamp, bool done) {
 }
 
 void Pipeline::Impl::setUpSources() {
-  if (options.input == InputKind::kPcap || options.input == InputKind::kLive) {
+  if (isRecording(options.input) || options.input == InputKind::kLive) {
     DriverInput in;
-    if (options.input == InputKind::kPcap) {
-      in.pcap = options.pcap;
-      in.rate = options.rate;
-    }
-    const bool throttle = options.input == InputKind::kPcap && !realtime;
+    if (options.input == InputKind::kPcap) in.pcap = options.pcap;
+    if (options.input == InputKind::kBag) in.bag = options.bag;
+    if (isRecording(options.input)) in.rate = options.rate;
+    for (const auto& [name, topic] : options.bag_topics)
+      if (name.empty() ? sensors.size() != 1 : std::find(sensors.begin(), sensors.end(), name) == sensors.end())
+        throw std::runtime_error(name.empty() ? "a bag topic without a sensor name (" + topic +
+                                                    ") needs a one-sensor rig: give SENSOR=TOPIC"
+                                              : "a bag topic for '" + name + "', which is not a sensor of the rig");
+    const bool throttle = isRecording(options.input) && !realtime;
     for (std::size_t s = 0; s < sensors.size(); ++s) {
       const int sensor = int(s);
+      if (const auto t = options.bag_topics.find(sensors[s]); t != options.bag_topics.end()) in.topic = t->second;
+      else if (const auto any = options.bag_topics.find(""); any != options.bag_topics.end()) in.topic = any->second;
+      else in.topic.clear();
       drivers.push_back(std::make_unique<SensorDriver>(
           rig.sensor(sensors[s]), in, source_stop, [this, sensor, throttle](Scan&& scan) {
             const std::int64_t t0 = steadyNs();

@@ -1,10 +1,14 @@
 #include "rigcal/pipeline/sensor_driver.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
+#include "rigcal/bag/bag_packet_source.hpp"
+#include "rigcal/bag/lidar_topic.hpp"
 #include "rigcal/drivers/info_port_source.hpp"
 #include "rigcal/drivers/paced_source.hpp"
+#include "rigcal/drivers/pacing.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
 #include "rigcal/drivers/scan_pump.hpp"
 #include "rigcal/drivers/udp_source.hpp"
@@ -53,16 +57,33 @@ class SensorDriver::ReceiveTimeTap : public drivers::PacketSource {
 SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput& input,
                            const std::atomic<bool>& stop, drivers::ScanAssembler::ScanCallback on_scan)
     : sensor_(sensor),
+      on_scan_(std::move(on_scan)),
       assembler_(sensor.name, drivers::AssemblerConfig{sensor.cut_angle_deg},
-                 [this, forward = std::move(on_scan)](Scan&& scan) {
-                   recordLag(scan);
-                   forward(std::move(scan));
+                 [this](Scan&& scan) {
+                   recordLag(scan, tap_ ? tap_->last_receive_ns : 0);
+                   on_scan_(std::move(scan));
                  }),
       stop_(stop),
-      live_(!input.pcap) {
+      live_(!input.pcap && !input.bag),
+      rate_(input.rate) {
   try {
     decoder_ = drivers::makeDecoder(decoderConfigFor(sensor));
-    if (input.pcap) {
+    if (input.bag) {
+      // The topic and its form from a first look at the bag; each source then streams its own copy.
+      const std::string wanted = !input.topic.empty() ? input.topic : sensor.source.topic.value_or("");
+      const bag::LidarTopic topic = bag::chooseLidarTopic(bag::Bag(*input.bag), wanted);
+      bag_topic_ = topic.name + " (" + topic.type + ")";
+      if (topic.form == bag::LidarTopicForm::kPointCloud2) {
+        if (!std::isfinite(input.rate) || input.rate < 0) throw std::invalid_argument("rate must be positive or 0");
+        clouds_ = std::make_unique<bag::BagCloudSource>(*input.bag, topic.name);
+        return;
+      }
+      raw_source_ = std::make_unique<bag::BagPacketSource>(*input.bag, topic.name);
+      source_ = std::make_unique<drivers::PacedSource>(*raw_source_, input.rate, stop_);
+    } else if (sensor.source.port == 0) {
+      throw std::runtime_error("has no UDP port: its source is the bag topic " + sensor.source.topic.value_or("") +
+                               " (read it with --bag)");
+    } else if (input.pcap) {
       raw_source_ = std::make_unique<drivers::PcapSource>(*input.pcap, filterFor(sensor, false));
       source_ = std::make_unique<drivers::PacedSource>(*raw_source_, input.rate, stop_);
     } else {
@@ -85,6 +106,7 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
 SensorDriver::~SensorDriver() = default;
 
 void SensorDriver::run(const std::function<void()>& idle) {
+  if (clouds_) return runClouds();
   drivers::pumpScans(*tap_, *decoder_, assembler_, [&](bool was_idle) {
     if (stop_.load(std::memory_order_relaxed)) return false;
     if (!was_idle) return true;
@@ -94,11 +116,40 @@ void SensorDriver::run(const std::function<void()>& idle) {
   });
 }
 
-void SensorDriver::recordLag(const Scan& scan) {
-  if (scan.empty() || tap_ == nullptr || tap_->last_receive_ns == 0) return;
+// Each cloud is a whole scan: paced by its log time like PacedSource paces packets, its lag measured
+// against that log time (the recorder's "arrival").
+void SensorDriver::runClouds() {
+  std::optional<TimeNs> first_recorded, start_wall;
+  TimeNs last_deadline = 0;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    auto cloud = clouds_->next();
+    if (!cloud) return;
+    if (rate_ > 0) {
+      if (!first_recorded) {
+        first_recorded = cloud->log_time_ns;
+        start_wall = drivers::monotonicNow();
+      }
+      last_deadline = std::max(last_deadline,
+                               *start_wall + TimeNs(double(cloud->log_time_ns - *first_recorded) / rate_));
+      if (!drivers::sleepUntil(last_deadline, stop_)) return;
+    }
+    cloud->scan.sensor_id = sensor_.name;
+    recordLag(cloud->scan, cloud->log_time_ns);
+    on_scan_(std::move(cloud->scan));
+  }
+}
+
+const drivers::SourceStats& SensorDriver::sourceStats() const {
+  return clouds_ ? clouds_->stats() : source_->stats();
+}
+
+std::string SensorDriver::warning() const { return clouds_ ? clouds_->warning() : source_->warning(); }
+
+void SensorDriver::recordLag(const Scan& scan, TimeNs receive_ns) {
+  if (scan.empty() || receive_ns == 0) return;
   const TimeNs end = scan.stamp_ns + *std::max_element(scan.offset_ns.begin(), scan.offset_ns.end());
   std::lock_guard lock(lag_mutex_);
-  if (lags_ms_.size() < kMaxLags) lags_ms_.push_back(double(tap_->last_receive_ns - end) * 1e-6);
+  if (lags_ms_.size() < kMaxLags) lags_ms_.push_back(double(receive_ns - end) * 1e-6);
 }
 
 std::optional<double> SensorDriver::clockLagMs() const {

@@ -1,4 +1,4 @@
-// `rigcal calibrate --config RIG (--pcap F [--rate R] | --live | --shm) [--out DIR] [--deadline S] [--realtime]
+// `rigcal calibrate --config RIG (--pcap F | --bag B [--topic S=T]...) [--rate R] | --live | --shm) [--out DIR] [--deadline S] [--realtime]
 // [--stats FILE.json] [--pin] [--cores 0,1]`: the main job (input, pinning and stats options as `rigcal map`).
 // Mapping starts at once; each calibration lidar is calibrated (on its own thread, while mapping goes on) as
 // soon as its frame budget is full, the others at the end of input, all within one calibration_deadline_s
@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "../bag_extrinsics.hpp"
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
 #include "../rig_loading.hpp"
@@ -68,6 +69,7 @@ void run(const CalibrateOptions& o) {
   config::RigConfig rig = loadRig(o.config);
   if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
   const pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
+  applyExtrinsicsFromBag(rig, po);
   const bool realtime = po.mode == pipeline::PipelineMode::kRealtime;
   prepareOutputFolder(o.out);
 
@@ -163,6 +165,7 @@ void run(const CalibrateOptions& o) {
 
   const auto progress_now = pipe->progress();
   const std::string source = po.input == pipeline::InputKind::kPcap ? po.pcap.string()
+                             : po.input == pipeline::InputKind::kBag  ? po.bag.string()
                              : po.input == pipeline::InputKind::kLive ? std::string("live")
                                                                        : std::string("shm");
   outcome.input_summary = {{"source", source},
@@ -256,7 +259,8 @@ void addCalibrateCommand(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->footer(kExitCodesHelp);
   cmd->callback([o, cmd] {
-    if (o->pipeline.pcap.empty() && !o->pipeline.live && !o->pipeline.shm) throw CLI::RequiredError("--pcap or --live or --shm");
+    if (o->pipeline.pcap.empty() && o->pipeline.bag.empty() && !o->pipeline.live && !o->pipeline.shm)
+      throw CLI::RequiredError("--pcap or --bag or --live or --shm");
     (void)cmd;
     run(*o);
   });

@@ -1,4 +1,4 @@
-// `rigcal calibrate-pose --pcap F --poses CSV (--config rig.yaml --sensor NAME | --model M ...) [--out DIR]`:
+// `rigcal calibrate-pose (--pcap F | --bag B [--topic T]) (--poses CSV | --pose-topic T | --pose-tf P:C) (--config rig.yaml --sensor NAME | --model M ...) [--out DIR]`:
 // lidar-to-pose-sensor calibration with time offset (the lidar_align successor). Decodes one lidar's
 // packets (every point keeps its own time), selects lidar_align's subset of the returns as the scans
 // arrive, calibrates against the poses and writes lidar_align's text, calibration.yaml and the fused
@@ -14,10 +14,14 @@
 #include "../exit_codes.hpp"
 #include "../rig_loading.hpp"
 #include "../output_folder.hpp"
+#include "rigcal/bag/bag_cloud_source.hpp"
+#include "rigcal/bag/bag_packet_source.hpp"
+#include "rigcal/bag/lidar_topic.hpp"
+#include "rigcal/bag/pose_message.hpp"
 #include "rigcal/calib/lidar_pose/lidar_pose_calibration.hpp"
-#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
 #include "rigcal/calib/lidar_pose/lidar_pose_output.hpp"
 #include "rigcal/calib/lidar_pose/pose_csv.hpp"
+#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
 #include "rigcal/config/config_error.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
@@ -32,7 +36,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct CalibratePoseArgs {
-  std::string pcap, poses, config, sensor, model, calibration, metadata, address, out;
+  std::string pcap, bag, topic, poses, pose_topic, pose_tf, pose_bag, config, sensor, model, calibration, metadata, address, out;
   std::string time_source = "sensor";
   int port = 0;
   std::uint64_t seed = 0;
@@ -73,8 +77,11 @@ Decoded decode(const CalibratePoseArgs& a, const calib::LidarPointSelection& sel
     const std::atomic<bool> stop{false};
     std::unique_ptr<pipeline::SensorDriver> driver;
     try {
-      driver = std::make_unique<pipeline::SensorDriver>(*sensor, pipeline::DriverInput{fs::path(a.pcap), 0.0}, stop,
-                                                        on_scan);
+      pipeline::DriverInput input;
+      if (a.bag.empty()) input.pcap = fs::path(a.pcap);
+      else input.bag = fs::path(a.bag);
+      input.topic = a.topic;
+      driver = std::make_unique<pipeline::SensorDriver>(*sensor, input, stop, on_scan);
     } catch (const std::exception& e) {
       throw CommandFailed(kExitInput, e.what());
     }
@@ -91,13 +98,28 @@ Decoded decode(const CalibratePoseArgs& a, const calib::LidarPointSelection& sel
   config.metadata = a.metadata;
   config.time_source = a.time_source == "host" ? TimeSource::kHostReceive : TimeSource::kSensorClock;
   std::unique_ptr<drivers::PacketDecoder> decoder;
-  std::unique_ptr<drivers::PcapSource> source;
+  std::unique_ptr<drivers::PacketSource> source;
   try {
     decoder = drivers::makeDecoder(config);
     drivers::PacketFilter filter;
     if (a.port) filter.destination_port = std::uint16_t(a.port);
     if (!a.address.empty()) filter.source_address = drivers::parseIpv4(a.address);
-    source = std::make_unique<drivers::PcapSource>(a.pcap, filter);
+    if (!a.bag.empty()) {
+      // A PointCloud2 topic needs no decoder: its clouds are the scans.
+      bag::Bag probe(a.bag);
+      if (bag::chooseLidarTopic(probe, a.topic).form == bag::LidarTopicForm::kPointCloud2) {
+        bag::BagCloudSource clouds(a.bag, a.topic);
+        d.name = "lidar";
+        while (auto cloud = clouds.next()) on_scan(std::move(cloud->scan));
+        d.packets = clouds.stats().packets;
+        d.malformed = clouds.stats().malformed;
+        d.warning = clouds.warning();
+        return d;
+      }
+      source = std::make_unique<bag::BagPacketSource>(a.bag, a.topic);
+    } else {
+      source = std::make_unique<drivers::PcapSource>(a.pcap, filter);
+    }
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());
   }
@@ -130,8 +152,15 @@ void run(CalibratePoseArgs a) {
     throw CommandFailed(kExitUsage, "calibrate-pose: give either --config with --sensor, or --model");
   if (!a.config.empty() && a.sensor.empty())
     throw CommandFailed(kExitUsage, "calibrate-pose: --config needs --sensor NAME");
-  requireInputFile(a.pcap, "capture");
-  requireInputFile(a.poses, "pose file");
+  if (a.pcap.empty() == a.bag.empty()) throw CommandFailed(kExitUsage, "calibrate-pose: give either --pcap or --bag");
+  if (!a.pcap.empty()) requireInputFile(a.pcap, "capture");
+  else if (!fs::exists(a.bag)) throw CommandFailed(kExitInput, a.bag + ": bag not found");
+  const int pose_inputs = int(!a.poses.empty()) + int(!a.pose_topic.empty()) + int(!a.pose_tf.empty());
+  if (pose_inputs != 1)
+    throw CommandFailed(kExitUsage, "calibrate-pose: give one of --poses CSV, --pose-topic TOPIC, --pose-tf PARENT:CHILD");
+  if (a.poses.empty() && a.bag.empty() && a.pose_bag.empty())
+    throw CommandFailed(kExitUsage, "calibrate-pose: --pose-topic / --pose-tf read a bag: give --bag or --pose-bag");
+  if (!a.poses.empty()) requireInputFile(a.poses, "pose file");
   if (!a.config.empty()) requireInputFile(a.config, "rig file");
   if (!a.out.empty()) prepareOutputFolder(a.out);
 
@@ -147,8 +176,37 @@ void run(CalibratePoseArgs a) {
   }
 
   calib::PoseCsv csv;
+  std::string pose_source = a.poses;
   try {
-    csv = calib::readPoseCsv(a.poses);
+    if (!a.poses.empty()) {
+      csv = calib::readPoseCsv(a.poses);
+    } else {
+      const std::string bag = a.pose_bag.empty() ? a.bag : a.pose_bag;
+      std::optional<std::pair<std::string, std::string>> frames;
+      if (!a.pose_tf.empty()) {
+        const auto colon = a.pose_tf.find(':');
+        if (colon == std::string::npos || colon == 0 || colon + 1 == a.pose_tf.size())
+          throw CommandFailed(kExitUsage, "--pose-tf must be PARENT:CHILD, got '" + a.pose_tf + "'");
+        frames.emplace(a.pose_tf.substr(0, colon), a.pose_tf.substr(colon + 1));
+      }
+      std::size_t malformed = 0;
+      const auto poses = bag::readBagPoses(bag, a.pose_topic, frames, &malformed);
+      pose_source = bag + " " + (frames ? "/tf " + a.pose_tf : a.pose_topic);
+      if (malformed) std::cerr << "warning: " << pose_source << ": " << malformed << " malformed messages skipped\n";
+      // The same parser and checks as a CSV (order, speed, re-centring): one path for every pose source.
+      std::ostringstream text;
+      text << std::setprecision(17);
+      for (std::size_t i = 0; i < poses.size(); ++i) {
+        const Eigen::Quaterniond q(poses[i].T_world_body.linear());
+        const Eigen::Vector3d t = poses[i].T_world_body.translation();
+        text << poses[i].stamp_ns << ',' << i << ',' << t.x() << ',' << t.y() << ',' << t.z() << ',' << q.w() << ','
+             << q.x() << ',' << q.y() << ',' << q.z() << '\n';
+      }
+      std::istringstream in(text.str());
+      csv = calib::parsePoseCsv(in, pose_source);
+    }
+  } catch (const CommandFailed&) {
+    throw;
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());
   }
@@ -156,9 +214,9 @@ void run(CalibratePoseArgs a) {
   try {
     trajectory = std::make_unique<calib::PoseTrajectory>(csv);
   } catch (const std::exception& e) {
-    throw CommandFailed(kExitInput, cat(a.poses, ": ", e.what()));
+    throw CommandFailed(kExitInput, cat(pose_source, ": ", e.what()));
   }
-  std::cout << "poses: " << csv.poses.size() << " from " << a.poses;
+  std::cout << "poses: " << csv.poses.size() << " from " << pose_source;
   if (!csv.origin.isZero())
     std::cout << std::fixed << std::setprecision(3) << " (re-centred by [" << csv.origin.x() << ", "
               << csv.origin.y() << ", " << csv.origin.z() << "])";
@@ -170,13 +228,14 @@ void run(CalibratePoseArgs a) {
             << d.malformed << " malformed, " << d.lost << " lost); " << c.kept << " selected (keep ratio "
             << s.selection.keep_points_ratio << ")\n";
   if (!d.warning.empty()) std::cerr << "warning: " << d.warning << '\n';
-  if (c.scans == 0) throw CommandFailed(kExitNotEnoughData, cat(a.pcap, ": no lidar scans decoded"));
+  const std::string lidar_source = a.pcap.empty() ? a.bag : a.pcap;
+  if (c.scans == 0) throw CommandFailed(kExitNotEnoughData, cat(lidar_source, ": no lidar scans decoded"));
 
   calib::LidarPoseResult r;
   try {
     r = calib::calibrateLidarPose(std::move(d.points), *trajectory, s);
   } catch (const std::exception& e) {  // poses not covering the lidar, too few points
-    throw CommandFailed(kExitInput, cat(a.poses, " vs ", a.pcap, ": ", e.what()));
+    throw CommandFailed(kExitInput, cat(pose_source, " vs ", lidar_source, ": ", e.what()));
   }
   std::cout << r.points.counts.outside_poses << " selected points dropped outside the poses' time range, "
             << r.points.size() << " used\n";
@@ -207,8 +266,14 @@ void addCalibratePoseCommand(CLI::App& app) {
   auto a = std::make_shared<CalibratePoseArgs>();
   auto* cmd = app.add_subcommand(
       "calibrate-pose", "Calibrate a lidar against a 6-DOF pose sensor (extrinsic + time offset), lidar_align style");
-  cmd->add_option("--pcap", a->pcap, "pcap or pcapng capture of the lidar")->required();
-  cmd->add_option("--poses", a->poses, "Poses CSV: timestamp_ns, index, px, py, pz, qw, qx, qy, qz")->required();
+  cmd->add_option("--pcap", a->pcap, "pcap or pcapng capture of the lidar");
+  cmd->add_option("--bag", a->bag, "Or a ROS 2 bag holding the lidar's packets or PointCloud2 (and the poses)");
+  cmd->add_option("--topic", a->topic, "With --bag: the lidar's topic (default: the bag's only lidar topic)");
+  cmd->add_option("--poses", a->poses, "Poses CSV: timestamp_ns, index, px, py, pz, qw, qx, qy, qz");
+  cmd->add_option("--pose-topic", a->pose_topic,
+                  "Poses from a bag topic: nav_msgs/Odometry, geometry_msgs/PoseStamped or TransformStamped");
+  cmd->add_option("--pose-tf", a->pose_tf, "Poses from the bag's /tf between two frames, PARENT:CHILD (e.g. map:base_link)");
+  cmd->add_option("--pose-bag", a->pose_bag, "The bag of --pose-topic / --pose-tf when not --bag");
   cmd->add_option("--config", a->config, "Rig file: decode the lidar as configured there (with --sensor)");
   cmd->add_option("--sensor", a->sensor, "The rig file's name of the lidar");
   cmd->add_option("--model", a->model, "Lidar model when no rig file is given, e.g. VLP-16, OS1-64");

@@ -1,6 +1,7 @@
-// `rigcal driver --config RIG --sensor NAME (--live | --pcap F [--rate R])`: one sensor's driver in its
+// `rigcal driver --config RIG --sensor NAME (--live | --pcap F [--rate R] | --bag B [--topic T] [--rate R])`: one sensor's driver in its
 // own process, writing every finished scan into the shared-memory ring /rigcal.<sensor>.
 #include <iomanip>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -21,7 +22,7 @@ namespace rigcal::app {
 namespace {
 
 struct DriverOptions {
-  std::string config, sensor, pcap, rate = "1.0", shm_prefix;
+  std::string config, sensor, pcap, bag, topic, rate = "1.0", shm_prefix;
   bool live = false, low_latency = false;
   unsigned slots = 8;
 };
@@ -66,7 +67,12 @@ void run(const DriverOptions& o) {
     throw CommandFailed(kExitConfig, e.what());
   }
   pipeline::DriverInput input;
-  if (!o.live) {
+  if (!o.bag.empty()) {
+    if (!std::filesystem::exists(o.bag)) throw CommandFailed(kExitInput, o.bag + ": bag not found");
+    input.bag = o.bag;
+    input.topic = o.topic;
+    input.rate = parseRate(o.rate);
+  } else if (!o.live) {
     requireInputFile(o.pcap, "capture");
     input.pcap = o.pcap;
     input.rate = parseRate(o.rate);
@@ -103,6 +109,7 @@ void run(const DriverOptions& o) {
             << o.slots << " slots, " << mebibytes(shm::ringBytes(o.slots, std::uint32_t(driver->maxPointsPerScan())))
             << " MiB)"
             << (ring->tookOver() ? " (took over a stale ring)" : "") << std::endl;
+  if (!driver->bagTopic().empty()) std::cout << "reading bag topic " << driver->bagTopic() << std::endl;
 
   driver->run([&] { ring->heartbeat(); });
 
@@ -129,9 +136,13 @@ void addDriverCommand(CLI::App& app) {
   cmd->add_option("--sensor", o->sensor, "Sensor name in the rig file")->required();
   auto* live = cmd->add_flag("--live", o->live, "Read the sensor's UDP port");
   auto* pcap = cmd->add_option("--pcap", o->pcap, "Read a capture instead");
+  auto* bag = cmd->add_option("--bag", o->bag, "Read a ROS 2 bag's packet or PointCloud2 topic instead");
   live->excludes(pcap);
-  cmd->add_option("--rate", o->rate, "With --pcap: 1.0 = recorded timing, 2 = twice as fast, max = no pacing")
-      ->needs(pcap);
+  bag->excludes(pcap);
+  bag->excludes(live);
+  cmd->add_option("--topic", o->topic, "With --bag: the sensor's topic (default: its source.topic, else the only lidar topic)")
+      ->needs(bag);
+  cmd->add_option("--rate", o->rate, "With --pcap or --bag: 1.0 = recorded timing, 2 = twice as fast, max = no pacing");
   cmd->add_option("--slots", o->slots, "Scans the ring keeps for slow readers")->check(CLI::Range(2u, 1024u));
   cmd->add_flag("--low-latency", o->low_latency,
                "Hold the CPU wake-up latency limit at 0 while running (/dev/cpu_dma_latency, needs root): "
@@ -139,7 +150,8 @@ void addDriverCommand(CLI::App& app) {
   cmd->add_option("--shm-prefix", o->shm_prefix, "Ring name prefix (default $RIGCAL_SHM_PREFIX or rigcal.)");
   cmd->footer(std::string("Stops at the end of the capture, or on Ctrl-C (live). ") + kExitCodesHelp);
   cmd->callback([o] {
-    if (!o->live && o->pcap.empty()) throw CommandFailed(kExitUsage, "driver needs --live or --pcap FILE");
+    if (!o->live && o->pcap.empty() && o->bag.empty())
+      throw CommandFailed(kExitUsage, "driver needs --live, --pcap FILE or --bag BAG");
     run(*o);
   });
 }

@@ -1,4 +1,4 @@
-// `rigcal map --config rig.yaml (--pcap F [--rate R] | --live | --shm) [--out DIR] [--stats FILE.json]
+// `rigcal map --config rig.yaml (--pcap F | --bag B [--topic S=T]...) [--rate R] | --live | --shm) [--out DIR] [--stats FILE.json]
 // [--pin] [--cores 0,1]`: runs the online pipeline (mapping, keyframes, pairing, frame selection) without
 // calibrating; prints the stage stats at exit and writes the trajectory, map.pcd and a selection summary.
 #include <unistd.h>
@@ -12,6 +12,7 @@
 #include <mutex>
 #include <thread>
 
+#include "../bag_extrinsics.hpp"
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
 #include "../rig_loading.hpp"
@@ -69,8 +70,9 @@ void writeSelection(const fs::path& file, const std::vector<std::shared_ptr<cons
 }
 
 void run(const MapArgs& a) {
-  const config::RigConfig rig = loadRig(a.config);
+  config::RigConfig rig = loadRig(a.config);
   const pipeline::PipelineOptions options = toPipelineOptions(a.pipeline);
+  applyExtrinsicsFromBag(rig, options);
   if (!a.out.empty()) prepareOutputFolder(a.out);
 
   std::mutex m;
@@ -123,7 +125,7 @@ void run(const MapArgs& a) {
               << mapping.map_cloud->size() << " points), selection.txt to " << a.out << '\n';
   }
   if (mapping.trajectory.empty()) throw CommandFailed(kExitNotEnoughData, "no mapping-lidar scan was registered");
-  if (StopSignals::requested() && options.input == pipeline::InputKind::kPcap)
+  if (StopSignals::requested() && pipeline::isRecording(options.input))
     throw CommandFailed(kExitInterrupted, "map interrupted (outputs hold what was mapped)");
 }
 

@@ -21,10 +21,14 @@ inline constexpr std::uintmax_t kMaxRigFileBytes = 1 << 20;          // a real r
 inline constexpr std::size_t kMaxSensors = 64;
 inline constexpr std::size_t kMaxSensorNameLength = 64;             // names are [A-Za-z0-9_.-]+
 inline constexpr std::uintmax_t kMaxReferencedFileBytes = 16 << 20;  // calibration / metadata files
+inline constexpr const char* kExtrinsicsFromBag = "from_bag";       // initial_extrinsics from the bag's tf
 
-/// Where a sensor's packets come from: a live UDP port, or the same port/address filter in a pcap.
+/// Where a sensor's packets come from: a live UDP port, or the same port/address filter in a pcap; or
+/// a ROS 2 bag topic (packets or sensor_msgs/PointCloud2) when reading a bag.
 struct SensorSource {
-  std::uint16_t port = 0;
+  std::uint16_t port = 0;                      // 0: none (a bag-topic-only sensor)
+  std::optional<std::string> topic;            // bag input: the sensor's topic
+  std::optional<std::string> frame;            // bag input: its tf frame (default: its messages' frame_id)
   std::optional<std::string> address;          // the sensor's IPv4 address (source filter)
   std::optional<std::string> multicast_group;  // live only: join this group
   /// Live only: the local IPv4 address to receive on (default any, 0.0.0.0). A loopback address
@@ -58,6 +62,9 @@ struct RigConfig {
   std::vector<SensorConfig> sensors;
   Roles roles;
   std::map<std::string, Pose> initial_T_base_sensor;  // every sensor has one
+  /// Sensors whose initial extrinsic is `from_bag`: the bag's tf tree replaces their identity placeholder
+  /// when a command reads a bag (ExtrinsicsFromBag in apps/rigcal).
+  std::vector<std::string> extrinsics_from_bag;
   VehicleFootprint vehicle;                           // `vehicle:`, else the default outline
   Parameters parameters;                              // crop box: from `vehicle`, unless set by name
   std::vector<std::string> warnings;                  // accepted but noteworthy (ignored upstream keys)

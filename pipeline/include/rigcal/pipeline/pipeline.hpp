@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -37,13 +38,21 @@ enum class InputKind : std::uint8_t {
   kPcap,       // driver threads read `pcap` (rate 0: as fast as possible, 1: recorded timing)
   kLive,       // driver threads on the sensors' UDP ports
   kShm,        // ScanRings written by `rigcal driver` processes
+  kBag,        // driver threads read `bag` (a ROS 2 bag: packet or PointCloud2 topics), paced as a pcap
 };
+
+/// A recording (pcap or bag): offline by default, replayed at `rate`.
+inline bool isRecording(InputKind k) { return k == InputKind::kPcap || k == InputKind::kBag; }
 
 struct PipelineOptions {
   PipelineMode mode = PipelineMode::kOffline;
   InputKind input = InputKind::kInProcess;
   std::filesystem::path pcap;              // kPcap
-  double rate = 0.0;                       // kPcap: replay speed (0 = as fast as possible)
+  double rate = 0.0;                       // kPcap, kBag: replay speed (0 = as fast as possible)
+  std::filesystem::path bag;               // kBag
+  /// kBag: sensor name → topic; the key "" names the topic of a one-sensor rig. A sensor not named here
+  /// reads its rig source.topic, else the bag's only lidar topic.
+  std::map<std::string, std::string> bag_topics;
   std::optional<std::string> shm_prefix;   // kShm: default $RIGCAL_SHM_PREFIX, else "rigcal."
   bool wait_for_writers = false;           // kShm: keep waiting when every ring writer is gone
   std::vector<int> cores;                  // pin every pipeline thread to these cores (empty: no pinning)

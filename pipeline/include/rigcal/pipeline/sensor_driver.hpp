@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "rigcal/bag/bag_cloud_source.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
 #include "rigcal/drivers/packet_source.hpp"
@@ -18,8 +19,16 @@
 namespace rigcal::pipeline {
 
 struct DriverInput {
-  std::optional<std::filesystem::path> pcap;  // empty: live UDP on the sensor's port
-  double rate = 0.0;                          // pcap only: 1.0 = recorded timing, 0 = as fast as possible
+  DriverInput() = default;
+  /// `{pcap, rate}` as before bags existed (no aggregate: the bag fields need no initializer there).
+  DriverInput(std::optional<std::filesystem::path> pcap_file, double replay_rate)
+      : pcap(std::move(pcap_file)), rate(replay_rate) {}
+  std::optional<std::filesystem::path> pcap;  // empty (and no bag): live UDP on the sensor's port
+  double rate = 0.0;                          // pcap or bag: 1.0 = recorded timing, 0 = as fast as possible
+  std::optional<std::filesystem::path> bag;   // a ROS 2 bag instead of a pcap
+  /// With a bag: the sensor's topic (packets or PointCloud2); empty: the sensor's source.topic, else
+  /// the bag's only lidar topic.
+  std::string topic;
 };
 
 /// The decoder settings of a rig sensor.
@@ -34,12 +43,14 @@ class SensorDriver {
                drivers::ScanAssembler::ScanCallback on_scan);
   ~SensorDriver();
 
-  /// Runs until the pcap ends or `stop` is set; calls `idle` whenever a live source timed out.
+  /// Runs until the pcap / bag ends or `stop` is set; calls `idle` whenever a live source timed out.
   void run(const std::function<void()>& idle = {});
   [[nodiscard]] std::size_t maxPointsPerScan() const { return decoder_->maxPointsPerScan(); }
   [[nodiscard]] const drivers::AssemblerStats& assemblerStats() const { return assembler_.stats(); }
-  [[nodiscard]] const drivers::SourceStats& sourceStats() const { return source_->stats(); }
-  [[nodiscard]] std::string warning() const { return source_->warning(); }
+  [[nodiscard]] const drivers::SourceStats& sourceStats() const;
+  [[nodiscard]] std::string warning() const;
+  /// With a bag: the topic read and its type ("/points (sensor_msgs/msg/PointCloud2)"); empty otherwise.
+  [[nodiscard]] const std::string& bagTopic() const { return bag_topic_; }
   /// The median over sweeps of (capture / receive time of the packet that closed the sweep − the sensor's
   /// time of the sweep's last point), in ms; nullopt before the first sweep. Sensors whose clocks agree
   /// show the same lag within the network's and the assembler's few ms (see SensorClockCheck).
@@ -47,13 +58,18 @@ class SensorDriver {
 
  private:
   config::SensorConfig sensor_;
+  drivers::ScanAssembler::ScanCallback on_scan_;
   std::unique_ptr<drivers::PacketSource> raw_source_;
   std::unique_ptr<drivers::PacketSource> source_;  // raw_source_, or a pacing wrapper around it
   std::unique_ptr<drivers::PacketDecoder> decoder_;
   drivers::ScanAssembler assembler_;
   const std::atomic<bool>& stop_;
   bool live_ = false;
-  void recordLag(const Scan& scan);
+  std::unique_ptr<bag::BagCloudSource> clouds_;  // a PointCloud2 topic: scans without packet decoding
+  double rate_ = 0.0;
+  std::string bag_topic_;
+  void runClouds();
+  void recordLag(const Scan& scan, TimeNs receive_ns);
   class ReceiveTimeTap;
   std::unique_ptr<ReceiveTimeTap> tap_;  // wraps source_: remembers the last packet's receive time
   mutable std::mutex lag_mutex_;

@@ -1,0 +1,333 @@
+// Bag input end to end through the real binary: a simulator recording turned into bags the two ways
+// drivers record lidars (raw packets; decoded PointCloud2), then `rigcal map --bag` must give the same
+// trajectory as `rigcal map --pcap`; `initial_extrinsics: from_bag` composes the bag's /tf_static;
+// calibrate-pose from a bag's Odometry equals the CSV path; bad bag input is a one-line error, exit 4.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <unistd.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "bag_from_recording.hpp"
+#include "rigcal/bag/tf_tree.hpp"
+#include "run_command.hpp"
+#include "sanitizers.hpp"
+#include "test_data.hpp"
+
+namespace rigcal::test {
+namespace {
+
+namespace fs = std::filesystem;
+using bag::test::SqliteBagWriter;
+
+std::string readText(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::string topicOf(const std::string& sensor, const char* form) { return "/sensing/lidar/" + sensor + "/" + form; }
+
+/// rig.yaml with every sensor's UDP source replaced by its bag topic (and, optionally, a new
+/// initial_extrinsics section).
+std::string rigWithTopics(const std::string& rig, const char* form, const std::string& extrinsics = {}) {
+  std::istringstream in(rig);
+  std::ostringstream out;
+  std::string line, sensor;
+  bool skipping = false;
+  const std::regex name(R"(^\s*- name: (\S+))");
+  while (std::getline(in, line)) {
+    std::smatch m;
+    if (std::regex_search(line, m, name)) sensor = m[1];
+    if (!extrinsics.empty() && line.rfind("initial_extrinsics:", 0) == 0) {
+      out << extrinsics;
+      skipping = true;
+      continue;
+    }
+    if (skipping && line.rfind("  ", 0) == 0) continue;
+    skipping = false;
+    if (line.find("source: {") != std::string::npos) {
+      out << line.substr(0, line.find("source:")) << "source: {topic: " << topicOf(sensor, form) << "}\n";
+      continue;
+    }
+    out << line << '\n';
+  }
+  return out.str();
+}
+
+/// One short parking-lot recording and its bags, made once for the suite.
+struct Recording {
+  TempDir dir;
+  config::RigConfig rig;
+  fs::path pcap, packets_bag, clouds_bag;
+  std::map<std::string, std::size_t> clouds;  // per sensor
+  std::string error;
+};
+Recording* g = nullptr;
+
+class BagPipeline : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    g = new Recording;
+    const auto sim = runRigcal({"sim", "--scenario", "parking-lot", "--duration", kSanitized ? "1.5" : "6", "--out",
+                                g->dir.path().string()});
+    if (sim.exit_code != 0) {
+      g->error = sim.err;
+      return;
+    }
+    g->rig = config::loadRigConfig(g->dir / "rig.yaml");
+    g->pcap = g->dir / "recording.pcap";
+    g->packets_bag = g->dir / "packets.db3";
+    g->clouds_bag = g->dir / "clouds.db3";
+    {
+      SqliteBagWriter packets(g->packets_bag);
+      for (const auto& s : g->rig.sensors) bag::test::writePacketTopic(packets, topicOf(s.name, "packets"), s, g->pcap);
+    }
+    SqliteBagWriter clouds(g->clouds_bag);
+    // /tf_static as Autoware publishes it: base_link -> sensor_kit_base_link -> each lidar (the truth
+    // would do; any chain does: the test checks the composition).
+    std::vector<bag::test::TfEdge> edges{{"base_link", "sensor_kit_base_link", fromXyzRpy({0.5, 0, 1.5, 0, 0, 0.1})}};
+    for (const auto& s : g->rig.sensors)
+      edges.push_back({"sensor_kit_base_link", s.name,
+                       fromXyzRpy({0.1 * double(edges.size()), -0.2, 0.3, 0.01, -0.02, 0.3 * double(edges.size())})});
+    bag::test::writeTfStatic(clouds, 1, edges);
+    for (const auto& s : g->rig.sensors)
+      g->clouds[s.name] = bag::test::writeCloudTopic(clouds, topicOf(s.name, "points"), s, g->pcap);
+  }
+  static void TearDownTestSuite() {
+    delete g;
+    g = nullptr;
+  }
+  void SetUp() override { ASSERT_TRUE(g->error.empty()) << g->error; }
+};
+
+std::vector<std::string> topicArgs(const char* form) {
+  std::vector<std::string> args;
+  for (const auto& s : g->rig.sensors) args.insert(args.end(), {"--topic", s.name + "=" + topicOf(s.name, form)});
+  return args;
+}
+
+/// Frames at the end of a map run that depend on thread timing at the end of input.
+constexpr std::size_t kEndFrames = 3;
+
+std::vector<std::string> trajectoryRows(const fs::path& out) {
+  std::istringstream in(readText(out / "trajectory.csv"));
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#') rows.push_back(line);
+  return rows;
+}
+
+TEST_F(BagPipeline, MapFromPacketBagEqualsMapFromPcapAndPointCloud2BagFollowsTheSamePath) {
+  TempDir out;
+  const auto from_pcap = runRigcal({"map", "--config", (g->dir / "rig.yaml").string(), "--pcap", g->pcap.string(),
+                                    "--out", (out / "pcap").string()});
+  ASSERT_EQ(from_pcap.exit_code, 0) << from_pcap.err;
+  std::vector<std::string> args{"map", "--config", (g->dir / "rig.yaml").string(), "--bag", g->packets_bag.string(),
+                                "--out", (out / "packets").string()};
+  const auto topics = topicArgs("packets");
+  args.insert(args.end(), topics.begin(), topics.end());
+  const auto from_packets = runRigcal(args);
+  ASSERT_EQ(from_packets.exit_code, 0) << from_packets.err;
+  const auto pcap_rows = trajectoryRows(out / "pcap");
+  ASSERT_GT(pcap_rows.size(), kSanitized ? 3u : 30u);
+  // The same payloads and stamps: the same frames, bit for bit. The pipeline's last frames depend on how
+  // the driver threads reach the end of input (two runs of the same pcap differ there too, by 1-2 frames
+  // of 70 measured), so the common run is compared, and it must be nearly all of it.
+  const auto packet_rows = trajectoryRows(out / "packets");
+  const std::size_t common = std::min(packet_rows.size(), pcap_rows.size());
+  EXPECT_GE(common + kEndFrames, std::max(packet_rows.size(), pcap_rows.size()));
+  for (std::size_t i = 0; i + kEndFrames < common; ++i) EXPECT_EQ(packet_rows[i], pcap_rows[i]) << "row " << i;
+
+  // PointCloud2: the rig names each sensor's topic (source: {topic: ...}); the clouds are the pcap's
+  // sweeps, so the mapper sees the same points at the same times.
+  std::ofstream(g->dir / "rig_clouds.yaml") << rigWithTopics(readText(g->dir / "rig.yaml"), "points");
+  const auto from_clouds = runRigcal({"map", "--config", (g->dir / "rig_clouds.yaml").string(), "--bag",
+                                      g->clouds_bag.string(), "--out", (out / "clouds").string()});
+  ASSERT_EQ(from_clouds.exit_code, 0) << from_clouds.err;
+  const auto cloud_rows = trajectoryRows(out / "clouds");
+  const std::size_t cloud_common = std::min(cloud_rows.size(), pcap_rows.size());
+  EXPECT_GE(cloud_common + kEndFrames, std::max(cloud_rows.size(), pcap_rows.size()));
+  for (std::size_t i = 0; i + kEndFrames < cloud_common; ++i) {
+    // sequence,stamp_ns,kind,lost,path_length_m,x,y,z,...
+    std::vector<std::string> a, b;
+    std::istringstream sa(pcap_rows[i]), sb(cloud_rows[i]);
+    for (std::string f; std::getline(sa, f, ',');) a.push_back(f);
+    for (std::string f; std::getline(sb, f, ',');) b.push_back(f);
+    ASSERT_GE(a.size(), 8u);
+    EXPECT_EQ(a[1], b[1]) << "row " << i << ": the same scan stamps";
+    for (std::size_t k = 5; k < 8; ++k) EXPECT_NEAR(std::stod(a[k]), std::stod(b[k]), 1e-3) << "row " << i;
+  }
+}
+
+TEST_F(BagPipeline, InitialExtrinsicsFromTheBagsTfStaticAreComposedToBaseLink) {
+  const bag::TfTree tree = bag::TfTree::fromBag(g->clouds_bag);
+  std::vector<std::string> path;
+  const Pose T = tree.lookup("base_link", "front_left", &path);
+  EXPECT_EQ(path, (std::vector<std::string>{"base_link", "sensor_kit_base_link", "front_left"}));
+  const Pose expected = fromXyzRpy({0.5, 0, 1.5, 0, 0, 0.1}) * fromXyzRpy({0.2, -0.2, 0.3, 0.01, -0.02, 0.6});
+  EXPECT_LT((T.matrix() - expected.matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  // The inverse direction walks the same tree.
+  EXPECT_LT((tree.lookup("front_left", "base_link").matrix() - expected.inverse().matrix()).cwiseAbs().maxCoeff(), 1e-12);
+
+  // Through the binary: the frames used are named, a missing frame lists the tree's frames.
+  std::ofstream(g->dir / "rig_from_bag.yaml") << rigWithTopics(readText(g->dir / "rig.yaml"), "points",
+                                                             "initial_extrinsics: from_bag\n");
+  TempDir out;
+  const auto ok = runRigcal({"map", "--config", (g->dir / "rig_from_bag.yaml").string(), "--bag",
+                             g->clouds_bag.string(), "--out", out.path().string()});
+  EXPECT_NE(ok.err.find("initial extrinsic of 'front_left' from the bag's tf: base_link -> sensor_kit_base_link -> "
+                        "front_left"),
+            std::string::npos)
+      << ok.err;
+  std::string rig = readText(g->dir / "rig_from_bag.yaml");
+  rig = std::regex_replace(rig, std::regex("topic: /sensing/lidar/front_right/points\\}"),
+                           "topic: /sensing/lidar/front_right/points, frame: front_right_optical}");
+  std::ofstream(g->dir / "rig_bad_frame.yaml") << rig;
+  const auto bad = runRigcal({"map", "--config", (g->dir / "rig_bad_frame.yaml").string(), "--bag",
+                              g->clouds_bag.string(), "--out", out.path().string()});
+  EXPECT_EQ(bad.exit_code, 4) << bad.err;
+  EXPECT_NE(bad.err.find("initial extrinsic of 'front_right' from_bag: frame front_right_optical is not in the tf "
+                         "tree; its frames: base_link, front_left, front_right, sensor_kit_base_link, top"),
+            std::string::npos)
+      << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+}
+
+TEST_F(BagPipeline, BadBagInputIsOneLineWithExitCode4) {
+  TempDir out;
+  const std::string rig = (g->dir / "rig.yaml").string();
+  const auto missing = runRigcal({"map", "--config", rig, "--bag", g->clouds_bag.string(), "--topic",
+                                  "top=/sensing/lidar/top/nope", "--out", out.path().string()});
+  EXPECT_EQ(missing.exit_code, 4);
+  EXPECT_NE(missing.err.find("topic /sensing/lidar/top/nope not in the bag; it has /tf_static, /sensing/lidar/top/points"),
+            std::string::npos)
+      << missing.err;
+  EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
+
+  const auto wrong_type = runRigcal({"calibrate", "--config", rig, "--bag", g->clouds_bag.string(), "--topic",
+                                     "top=/tf_static", "--out", (out / "cal").string()});
+  EXPECT_EQ(wrong_type.exit_code, 4);
+  EXPECT_NE(wrong_type.err.find("topic /tf_static has type tf2_msgs/msg/TFMessage, not a lidar type"), std::string::npos)
+      << wrong_type.err;
+  EXPECT_EQ(std::count(wrong_type.err.begin(), wrong_type.err.end(), '\n'), 1) << wrong_type.err;
+
+  { SqliteBagWriter empty(out / "empty.db3"); }
+  const auto empty = runRigcal({"map", "--config", rig, "--bag", (out / "empty.db3").string(), "--out",
+                                out.path().string()});
+  EXPECT_EQ(empty.exit_code, 4);
+  EXPECT_NE(empty.err.find("empty.db3: empty bag"), std::string::npos) << empty.err;
+  EXPECT_EQ(std::count(empty.err.begin(), empty.err.end(), '\n'), 1) << empty.err;
+
+  const auto unnamed = runRigcal({"map", "--config", rig, "--bag", g->packets_bag.string(), "--out", out.path().string()});
+  EXPECT_EQ(unnamed.exit_code, 4);
+  EXPECT_NE(unnamed.err.find("several lidar topics"), std::string::npos) << unnamed.err;
+}
+
+
+// `rigcal driver --bag`: one sensor's packets or clouds from the bag into its ring, as from the pcap.
+TEST_F(BagPipeline, DriverPublishesTheBagsScansAsThePcaps) {
+  const std::string rig = (g->dir / "rig.yaml").string();
+  const std::string prefix = "rigcal.bagtest" + std::to_string(::getpid()) + ".";
+  const auto published = [](const CommandResult& r) {
+    const auto at = r.out.find(" scans published");
+    const auto from = r.out.rfind(' ', at - 1);
+    return at == std::string::npos ? -1 : std::stoi(r.out.substr(from + 1, at - from - 1));
+  };
+  const auto pcap = runRigcal({"driver", "--config", rig, "--sensor", "front_left", "--pcap", g->pcap.string(),
+                               "--rate", "max", "--shm-prefix", prefix});
+  ASSERT_EQ(pcap.exit_code, 0) << pcap.err;
+  const auto packets = runRigcal({"driver", "--config", rig, "--sensor", "front_left", "--bag", g->packets_bag.string(),
+                                  "--topic", topicOf("front_left", "packets"), "--rate", "max", "--shm-prefix", prefix});
+  ASSERT_EQ(packets.exit_code, 0) << packets.err;
+  EXPECT_NE(packets.out.find("reading bag topic /sensing/lidar/front_left/packets (nebula_msgs/msg/NebulaPackets)"),
+            std::string::npos) << packets.out;
+  const auto clouds = runRigcal({"driver", "--config", rig, "--sensor", "front_left", "--bag", g->clouds_bag.string(),
+                                 "--topic", topicOf("front_left", "points"), "--rate", "max", "--shm-prefix", prefix});
+  ASSERT_EQ(clouds.exit_code, 0) << clouds.err;
+  ASSERT_GT(published(pcap), 3);
+  EXPECT_EQ(published(packets), published(pcap)) << packets.out;
+  EXPECT_EQ(published(clouds), int(g->clouds["front_left"])) << clouds.out;
+}
+
+/// poses.csv rows (timestamp_ns, index, px py pz, qw qx qy qz) as nav_msgs/Odometry and as /tf map ->
+/// base_link, the values copied exactly (the bag holds what the CSV holds).
+void writePoseTopics(SqliteBagWriter& bag, const fs::path& csv) {
+  const int odom = bag.topic("/odom", "nav_msgs/msg/Odometry");
+  const int tf = bag.topic("/tf", "tf2_msgs/msg/TFMessage");
+  std::istringstream in(readText(csv));
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream row(line);
+    std::vector<std::string> f;
+    for (std::string v; std::getline(row, v, ',');) f.push_back(v);
+    ASSERT_EQ(f.size(), 9u) << line;
+    const TimeNs stamp = std::stoll(f[0]);
+    const double p[3] = {std::stod(f[2]), std::stod(f[3]), std::stod(f[4])};
+    const double q[4] = {std::stod(f[6]), std::stod(f[7]), std::stod(f[8]), std::stod(f[5])};  // x y z w
+    bag::test::CdrWriter o;
+    o.putHeader(stamp, "map").putString("base_link");
+    for (double v : p) o.put(v);
+    for (double v : q) o.put(v);
+    for (int i = 0; i < 36 + 6 + 36; ++i) o.put(0.0);
+    bag.write(odom, stamp, o.bytes());
+    bag::test::CdrWriter t;
+    t.put(std::uint32_t(1)).putHeader(stamp, "map").putString("base_link");
+    for (double v : p) t.put(v);
+    for (double v : q) t.put(v);
+    bag.write(tf, stamp, t.bytes());
+  }
+}
+
+YAML::Node poseResult(const fs::path& out) { return YAML::LoadFile((out / "calibration.yaml").string())["pose_sensor"]["lidar"]; }
+
+// calibrate-pose with the lidar's packets and the INS poses from a bag (Odometry, or /tf between two
+// frames) gives the result of the pcap + CSV path.
+TEST(BagPoses, CalibratePoseFromOdometryAndTfEqualsTheCsvPath) {
+  TempDir dir;
+  const auto sim = runRigcal({"sim", "--scenario", "pose", "--duration", kSanitized ? "3" : "6", "--out",
+                              dir.path().string()});
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const config::RigConfig rig = config::loadRigConfig(dir / "rig.yaml");
+  {
+    SqliteBagWriter bag(dir / "drive.db3");
+    bag::test::writePacketTopic(bag, "/sensing/lidar/top/velodyne_packets", rig.sensors.front(), dir / "recording.pcap");
+    ASSERT_NO_FATAL_FAILURE(writePoseTopics(bag, dir / "poses.csv"));
+  }
+  const std::vector<std::string> common{"--config", (dir / "rig.yaml").string(), "--sensor", "lidar", "--keep-ratio",
+                                        kSanitized ? "0.002" : "0.01", "--max-evals", kSanitized ? "20" : "60",
+                                        "--threads", "1"};
+  const auto run = [&](std::vector<std::string> args, const std::string& out) {
+    args.insert(args.begin(), "calibrate-pose");
+    args.insert(args.end(), common.begin(), common.end());
+    args.insert(args.end(), {"--out", (dir / out).string()});
+    return runRigcal(args);
+  };
+  const auto csv = run({"--pcap", (dir / "recording.pcap").string(), "--poses", (dir / "poses.csv").string()}, "csv");
+  ASSERT_EQ(csv.exit_code, 0) << csv.out << csv.err;
+  const auto odom = run({"--bag", (dir / "drive.db3").string(), "--pose-topic", "/odom"}, "odom");
+  ASSERT_EQ(odom.exit_code, 0) << odom.out << odom.err;
+  EXPECT_NE(odom.out.find("drive.db3 /odom (re-centred by"), std::string::npos) << odom.out;
+  const auto tf = run({"--bag", (dir / "drive.db3").string(), "--pose-tf", "map:base_link"}, "tf");
+  ASSERT_EQ(tf.exit_code, 0) << tf.out << tf.err;
+  const YAML::Node expected = poseResult(dir / "csv");
+  for (const char* out : {"odom", "tf"}) {
+    const YAML::Node got = poseResult(dir / out);
+    for (const char* key : {"x", "y", "z", "roll", "pitch", "yaw", "time_offset_s"})
+      EXPECT_NEAR(got[key].as<double>(), expected[key].as<double>(), 2e-6) << out << ' ' << key;
+  }
+
+  const auto wrong = run({"--bag", (dir / "drive.db3").string(), "--pose-topic", "/sensing/lidar/top/velodyne_packets"},
+                         "wrong");
+  EXPECT_EQ(wrong.exit_code, 4);
+  EXPECT_NE(wrong.err.find("has type nebula_msgs/msg/NebulaPackets, not a pose type"), std::string::npos) << wrong.err;
+  const auto no_frames = run({"--bag", (dir / "drive.db3").string(), "--pose-tf", "odom:imu"}, "none");
+  EXPECT_EQ(no_frames.exit_code, 4);
+  EXPECT_NE(no_frames.err.find("no transform between odom and imu on /tf; its frames are base_link, map"),
+            std::string::npos) << no_frames.err;
+}
+
+}  // namespace
+}  // namespace rigcal::test
