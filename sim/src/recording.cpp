@@ -76,14 +76,15 @@ std::vector<std::unique_ptr<PacketEncoder>> makeEncoders(const Simulation& sim) 
 
 RecordingResult writeRecording(const Simulation& sim, std::vector<std::unique_ptr<PacketEncoder>> encoders,
                                const std::filesystem::path& pcap, const SimulationOptions& options,
-                               SimulationSink* also) {
+                               SimulationSink* also, DatagramObserver* datagrams) {
   if (encoders.size() != sim.sensorCount()) throw std::invalid_argument("writeRecording: one encoder per sensor");
   std::vector<RecordingSensor> endpoints;
   for (std::size_t i = 0; i < sim.sensorCount(); ++i) {
     if (!encoders[i]) throw std::invalid_argument("writeRecording: no packet encoder for " + sim.scenario().sensors[i].model);
     endpoints.push_back(recordingEndpoints(sim.scenario().sensors[i], sim.model(i)));
   }
-  RecordingWriter writer(pcap, std::move(endpoints), hashKeys(sim.scenario().seed, 0x6e6963ULL));  // "nic"
+  RecordingWriter writer(pcap, std::move(endpoints), hashKeys(sim.scenario().seed, 0x6e6963ULL),  // "nic"
+                         datagrams);
   RecordingSink sink(std::move(encoders), writer, also);
   SimulationOptions o = options;
   o.build_scans = options.build_scans && also != nullptr;

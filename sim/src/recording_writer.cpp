@@ -14,8 +14,10 @@ TimeNs datagramWireTimeNs(std::size_t payload_bytes) {
 }
 
 RecordingWriter::RecordingWriter(const std::filesystem::path& file, std::vector<RecordingSensor> sensors,
-                                 std::uint64_t seed)
-    : pcap_(file), sensors_(std::move(sensors)), nic_(seed) {}
+                                 std::uint64_t seed, DatagramObserver* observer)
+    : observer_(observer), sensors_(std::move(sensors)), nic_(seed) {
+  if (!file.empty()) pcap_.emplace(file);
+}
 
 void RecordingWriter::add(std::size_t sensor, std::vector<EncodedPacket>& packets) {
   for (auto& p : packets)
@@ -31,7 +33,8 @@ void RecordingWriter::flushUntil(TimeNs true_time) {
     const TimeNs stamp = nic_.stamp(p.send_true_ns, datagramWireTimeNs(p.payload.size()));
     NetEndpoint destination = s.destination;
     if (p.port != 0) destination.port = p.port;
-    pcap_.writeDatagram(s.source, destination, p.payload, stamp);
+    if (pcap_) pcap_->writeDatagram(s.source, destination, p.payload, stamp);
+    if (observer_) observer_->onDatagram(p.sensor, destination.port, p.payload, stamp);
     ++datagrams_;
     queue_.pop();
   }
@@ -39,7 +42,7 @@ void RecordingWriter::flushUntil(TimeNs true_time) {
 
 void RecordingWriter::finish() {
   flushUntil(std::numeric_limits<TimeNs>::max());
-  pcap_.close();
+  if (pcap_) pcap_->close();
 }
 
 }  // namespace rigcal::sim

@@ -92,15 +92,11 @@ void writeTruthYaml(const Simulation& sim, const std::filesystem::path& file) {
   writeFile(file, y.str());
 }
 
-void writePosesCsv(const Simulation& sim, const std::filesystem::path& file) {
+std::vector<PoseSample> poseSamples(const Simulation& sim) {
   const Scenario& sc = sim.scenario();
   const PoseSensorSpec p = sc.pose_sensor.value_or(PoseSensorSpec{"base_link"});
   Rng rng(hashKeys(sc.seed, 0x706f736573ULL));  // "poses"
-  std::ostringstream out;
-  out << "# rigcal sim: " << p.name << " in the world frame at " << exact(p.rate_hz)
-      << " Hz (lidar_align layout; positions include origin [" << fixed(p.origin.x(), 3) << ", "
-      << fixed(p.origin.y(), 3) << ", " << fixed(p.origin.z(), 3) << "])\n";
-  out << "# timestamp_ns, index, px, py, pz, qw, qx, qy, qz\n";
+  std::vector<PoseSample> out;
   const double period_ns = 1e9 / p.rate_hz;
   for (std::int64_t k = 0;; ++k) {
     const TimeNs t = sim.startTime() + TimeNs(double(k) * period_ns + 0.5);
@@ -114,10 +110,30 @@ void writePosesCsv(const Simulation& sim, const std::filesystem::path& file) {
       T.translation() += p.position_noise_m * dp;
       T.linear() = T.linear() * expSO3(deg2rad(p.rotation_noise_deg) * dr);
     }
-    const Eigen::Vector3d x = T.translation() + p.origin;
-    Eigen::Quaterniond q(T.linear());
+    T.translation() += p.origin;
+    out.push_back({t + p.clock_offset_ns, T});
+  }
+  return out;
+}
+
+std::string poseFrame(const Simulation& sim) {
+  return sim.scenario().pose_sensor ? sim.scenario().pose_sensor->name : std::string("base_link");
+}
+
+void writePosesCsv(const Simulation& sim, const std::filesystem::path& file) {
+  const Scenario& sc = sim.scenario();
+  const PoseSensorSpec p = sc.pose_sensor.value_or(PoseSensorSpec{"base_link"});
+  std::ostringstream out;
+  out << "# rigcal sim: " << p.name << " in the world frame at " << exact(p.rate_hz)
+      << " Hz (lidar_align layout; positions include origin [" << fixed(p.origin.x(), 3) << ", "
+      << fixed(p.origin.y(), 3) << ", " << fixed(p.origin.z(), 3) << "])\n";
+  out << "# timestamp_ns, index, px, py, pz, qw, qx, qy, qz\n";
+  std::int64_t k = 0;
+  for (const PoseSample& sample : poseSamples(sim)) {
+    const Eigen::Vector3d x = sample.T_world_pose.translation();
+    Eigen::Quaterniond q(sample.T_world_pose.linear());
     if (q.w() < 0) q.coeffs() = -q.coeffs();
-    out << (t + p.clock_offset_ns) << ", " << k << ", " << fixed(x.x(), 6) << ", " << fixed(x.y(), 6) << ", "
+    out << sample.stamp_ns << ", " << k++ << ", " << fixed(x.x(), 6) << ", " << fixed(x.y(), 6) << ", "
         << fixed(x.z(), 6) << ", " << fixed(q.w(), 9) << ", " << fixed(q.x(), 9) << ", " << fixed(q.y(), 9) << ", "
         << fixed(q.z(), 9) << "\n";
   }

@@ -1,7 +1,9 @@
-// `rigcal sim --scenario NAME|FILE.yaml --out DIR [--seed N]`: a synthetic rig recording with ground
-// truth. Writes truth.yaml, poses.csv, rig.yaml (+ the sensors' calibration/metadata files) and, when
-// every sensor's model has a packet encoder, recording.pcap; --dump-scans adds the simulated sweeps as
-// PCD files per sensor.
+// `rigcal sim --scenario NAME|FILE.yaml --out DIR [--seed N] [--format pcap|mcap|both]`: a synthetic rig
+// recording with ground truth. Writes truth.yaml, poses.csv, rig.yaml (+ the sensors' calibration/metadata
+// files) and, when every sensor's model has a packet encoder, recording.pcap; --format mcap (or both)
+// writes the recording as MCAP bags instead (or too): recording.mcap (packets) and recording_points.mcap
+// (PointCloud2), each with /tf_static and /odom (see sim/bag_recording.hpp); --dump-scans adds the
+// simulated sweeps as PCD files per sensor.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +16,7 @@
 #include "../output_folder.hpp"
 #include "rigcal/core/pcd_io.hpp"
 #include "rigcal/core/point_table.hpp"
+#include "rigcal/sim/bag_recording.hpp"
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/recording.hpp"
 #include "rigcal/sim/simulation.hpp"
@@ -32,6 +35,7 @@ struct SimArgs {
   int threads = 2;
   std::optional<double> perturb_translation_m, perturb_rotation_deg;
   std::optional<double> duration_s;  // simulate only the first seconds of the trajectory
+  std::string format = "pcap";       // pcap, mcap or both
 };
 
 // Writes every simulated sweep as a PCD file under DIR/scans/<sensor>/.
@@ -101,32 +105,53 @@ void run(const SimArgs& a) {
   for (std::size_t i = 0; i < s.sensorCount(); ++i)
     if (!encoders[i] && std::find(missing.begin(), missing.end(), scenario.sensors[i].model) == missing.end())
       missing.push_back(scenario.sensors[i].model);
+  const bool want_pcap = a.format != "mcap", want_mcap = a.format != "pcap";
   const fs::path pcap = out / "recording.pcap";
+  const fs::path packets_bag = out / "recording.mcap", points_bag = out / "recording_points.mcap";
+  // Never leave a file that does not match this run.
+  for (const auto& f : {pcap, packets_bag, points_bag}) {
+    std::error_code ignored;  // absent is fine; a symlink is removed, never followed
+    fs::remove(f, ignored);
+  }
   if (!missing.empty()) {
     std::string models;
     for (const auto& m : missing) models += (models.empty() ? "" : ", ") + m;
-    if (fs::exists(pcap)) fs::remove(pcap);  // never leave a capture that does not match this run
-    std::cout << "recording.pcap NOT written: there is no packet encoder yet for " << models
-              << "\n";
+    std::cout << (want_mcap ? "recording.pcap and recording.mcap" : "recording.pcap")
+              << " NOT written: there is no packet encoder yet for " << models << "\n";
   }
   std::unique_ptr<ScanDumper> dumper;
   if (a.dump_scans) dumper = std::make_unique<ScanDumper>(s, out / "scans");
-  if (!missing.empty() && !dumper) {
+  std::unique_ptr<sim::BagRecording> bags;
+  if (want_mcap)
+    bags = std::make_unique<sim::BagRecording>(s, missing.empty() ? packets_bag : fs::path(), points_bag,
+                                               bag::McapWriterOptions{}, dumper.get());
+  sim::SimulationSink* sink = bags ? static_cast<sim::SimulationSink*>(bags.get()) : dumper.get();
+  if (!missing.empty() && !sink) {
     std::cout << "physics not run: nothing to write (use --dump-scans for the simulated sweeps as PCD)\n";
     return;
   }
   sim::SimulationOptions options;
   options.threads = a.threads;
-  options.build_scans = bool(dumper);
+  options.build_scans = sink != nullptr && (dumper || want_mcap);
   if (a.duration_s) options.max_duration_ns = fromSeconds(*a.duration_s);
   if (a.duration_s) std::cout << "simulating the first " << *a.duration_s << " s only (--duration)\n";
   sim::SimulationStats st;
   if (missing.empty()) {
-    const sim::RecordingResult r = sim::writeRecording(s, std::move(encoders), pcap, options, dumper.get());
+    const sim::RecordingResult r =
+        sim::writeRecording(s, std::move(encoders), want_pcap ? pcap : fs::path(), options, sink, bags.get());
     st = r.stats;
-    std::cout << "wrote " << pcap.string() << ": " << r.datagrams << " datagrams in " << r.frames << " frames\n";
+    if (want_pcap)
+      std::cout << "wrote " << pcap.string() << ": " << r.datagrams << " datagrams in " << r.frames << " frames\n";
   } else {
-    st = s.run(*dumper, options);
+    st = s.run(*sink, options);
+  }
+  if (bags) {
+    bags->close();
+    if (missing.empty())
+      std::cout << "wrote " << packets_bag.string() << ": " << bags->packetMessages()
+                << " packet messages on /<sensor>/packets, /tf_static, /odom\n";
+    std::cout << "wrote " << points_bag.string() << ": " << bags->cloudMessages()
+              << " PointCloud2 on /<sensor>/points, /tf_static, /odom\n";
   }
   std::cout << std::setprecision(2) << "simulated " << st.firings << " firings, " << st.rays << " rays, "
             << st.returns << " returns, " << st.scans << " sweeps in " << st.total_seconds << " s ("
@@ -156,6 +181,11 @@ void addSimCommand(CLI::App& app) {
   cmd->add_flag("--dump-scans", a->dump_scans, "Also write every simulated sweep as PCD under DIR/scans/<sensor>/");
   cmd->add_option("--duration", a->duration_s, "Simulate only the first S seconds of the scenario (default: all of it)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--format", a->format,
+                  "pcap: recording.pcap; mcap: recording.mcap (packet messages) and recording_points.mcap "
+                  "(PointCloud2), each with /tf_static and /odom; both: all three")
+      ->check(CLI::IsMember({"pcap", "mcap", "both"}))
+      ->capture_default_str();
   cmd->add_flag("--list", a->list, "List the preset scenarios and exit");
   cmd->footer(kExitCodesHelp);
   cmd->callback([a] { run(*a); });

@@ -21,6 +21,16 @@ std::map<std::string, Pose> perturbedExtrinsics(const Scenario& scenario);
 /// truth.yaml: T_base_sensor, T_mapping_calib, clock offsets, scan phases, pose-sensor truth.
 void writeTruthYaml(const Simulation& sim, const std::filesystem::path& file);
 
+/// One sample of the pose sensor as poses.csv (and the bag's /odom) carry it.
+struct PoseSample {
+  TimeNs stamp_ns = 0;                     // pose sensor clock
+  Pose T_world_pose = Pose::Identity();    // noise and origin included
+};
+/// The pose sensor (or base_link when the scenario has none) at its rate, noise drawn as for poses.csv.
+std::vector<PoseSample> poseSamples(const Simulation& sim);
+/// The pose sensor's name ("base_link" when the scenario has none).
+std::string poseFrame(const Simulation& sim);
+
 /// poses.csv: the pose sensor (or base_link when the scenario has none) at its rate, lidar_align
 /// layout `timestamp_ns, index, px, py, pz, qw, qx, qy, qz`, with a `#` header; optional noise.
 void writePosesCsv(const Simulation& sim, const std::filesystem::path& file);

@@ -28,11 +28,12 @@ std::uint16_t infoPort(const SensorSpec& sensor, const LidarModel& model);
 /// Encoders for every sensor (nullptr entries where a model has none yet).
 std::vector<std::unique_ptr<PacketEncoder>> makeEncoders(const Simulation& sim);
 
-/// Runs `sim` and writes `pcap`. `encoders` has one non-null encoder per sensor; `also` (optional)
-/// receives the same firings and sweeps (e.g. to dump them). Throws std::invalid_argument when an
+/// Runs `sim` and writes `pcap` (none when empty). `encoders` has one non-null encoder per sensor; `also`
+/// (optional) receives the same firings and sweeps (e.g. to dump them), `datagrams` (optional) every
+/// datagram with its capture stamp (e.g. to write a bag). Throws std::invalid_argument when an
 /// encoder is missing, std::runtime_error on I/O errors.
 RecordingResult writeRecording(const Simulation& sim, std::vector<std::unique_ptr<PacketEncoder>> encoders,
                                const std::filesystem::path& pcap, const SimulationOptions& options,
-                               SimulationSink* also = nullptr);
+                               SimulationSink* also = nullptr, DatagramObserver* datagrams = nullptr);
 
 }  // namespace rigcal::sim

@@ -4,7 +4,9 @@
 // reference clock, and the NIC stamps it after a link latency and a seeded jitter.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <queue>
+#include <span>
 #include <vector>
 
 #include "rigcal/sim/packet_encoder.hpp"
@@ -18,9 +20,20 @@ struct RecordingSensor {
   TimeNs clock_offset_ns = 0;  // sensor clock = true clock + offset
 };
 
+/// Sees every datagram as it is written (e.g. to record it into a bag too), in capture order.
+class DatagramObserver {
+ public:
+  virtual ~DatagramObserver() = default;
+  /// `port`: the destination port (the sensor's data port, or its info port for RoboSense DIFOP).
+  virtual void onDatagram(std::size_t sensor, std::uint16_t port, std::span<const std::uint8_t> payload,
+                          TimeNs capture_ns) = 0;
+};
+
 class RecordingWriter {
  public:
-  RecordingWriter(const std::filesystem::path& file, std::vector<RecordingSensor> sensors, std::uint64_t seed);
+  /// An empty `file` writes no pcap (only the observer sees the datagrams).
+  RecordingWriter(const std::filesystem::path& file, std::vector<RecordingSensor> sensors, std::uint64_t seed,
+                  DatagramObserver* observer = nullptr);
 
   /// Queues a sensor's packets (in its send order).
   void add(std::size_t sensor, std::vector<EncodedPacket>& packets);
@@ -30,7 +43,7 @@ class RecordingWriter {
   /// Writes everything left and closes the file.
   void finish();
   [[nodiscard]] std::uint64_t datagrams() const { return datagrams_; }
-  [[nodiscard]] std::uint64_t frames() const { return pcap_.frames(); }
+  [[nodiscard]] std::uint64_t frames() const { return pcap_ ? pcap_->frames() : 0; }
 
  private:
   struct Pending {
@@ -47,7 +60,8 @@ class RecordingWriter {
                                              : a.order > b.order;
     }
   };
-  PcapWriter pcap_;
+  std::optional<PcapWriter> pcap_;
+  DatagramObserver* observer_ = nullptr;
   std::vector<RecordingSensor> sensors_;
   NicClock nic_;
   std::priority_queue<Pending, std::vector<Pending>, Later> queue_;
