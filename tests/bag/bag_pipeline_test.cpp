@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "bag_from_recording.hpp"
+#include "rigcal/bag/bag_cloud_source.hpp"
 #include "rigcal/bag/tf_tree.hpp"
 #include "run_command.hpp"
 #include "sanitizers.hpp"
@@ -200,8 +201,18 @@ TEST_F(BagPipeline, InitialExtrinsicsFromTheBagsTfStaticAreComposedToBaseLink) {
       }
     }
   }
-  std::ofstream(g->dir / "rig_from_bag.yaml") << rigWithTopics(readText(g->dir / "rig.yaml"), "points",
-                                                             "initial_extrinsics: from_bag\n");
+  // Decoded clouds need no packet model: `model: PointCloud2` (no calibration or metadata file).
+  std::ofstream(g->dir / "rig_from_bag.yaml") << std::regex_replace(
+      rigWithTopics(readText(g->dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
+      std::regex("model: \\S+"), "model: PointCloud2");
+  const auto checked = runRigcal({"check-config", (g->dir / "rig_from_bag.yaml").string()});
+  EXPECT_EQ(checked.exit_code, 0) << checked.err;
+  EXPECT_NE(checked.out.find("topic /sensing/lidar/top/points  (initial extrinsic from_bag)"), std::string::npos)
+      << checked.out;
+  const auto pcap_for_clouds = runRigcal({"map", "--config", (g->dir / "rig_from_bag.yaml").string(), "--pcap",
+                                          g->pcap.string(), "--out", out.path().string()});
+  EXPECT_EQ(pcap_for_clouds.exit_code, 2) << pcap_for_clouds.err;
+  EXPECT_NE(pcap_for_clouds.err.find("initial_extrinsics from_bag needs --bag"), std::string::npos) << pcap_for_clouds.err;
   const auto ok = runRigcal({"map", "--config", (g->dir / "rig_from_bag.yaml").string(), "--bag", small.string(),
                              "--out", out.path().string()});
   EXPECT_NE(ok.err.find("initial extrinsic of 'front_left' from the bag's tf: base_link -> sensor_kit_base_link -> "
@@ -363,6 +374,37 @@ TEST(BagSimMcapLong, ParkingLotCalibratedFromItsMcapsAsFromItsPcap) {
   calibrate((sim_dir / "rig.yaml").string(), packets, "packets");
   calibrate((sim_dir / "rig_from_bag.yaml").string(), {"--bag", (sim_dir / "recording_points.mcap").string()},
             "points");
+}
+
+// A PointCloud2 message that does not decode is counted and dropped; the clouds around it still arrive.
+TEST(BagCloudSource, AMalformedCloudIsDroppedAndTheOthersKept) {
+  TempDir dir;
+  {
+    SqliteBagWriter bag(dir / "clouds.db3");
+    const int id = bag.topic("/points", "sensor_msgs/msg/PointCloud2");
+    for (int k = 0; k < 3; ++k) {
+      Scan scan;
+      scan.stamp_ns = 1'000'000'000 + k * 100'000'000;
+      for (int i = 0; i < 5; ++i)
+        scan.push_back({float(i + 1), 0.5f, 0.25f, 2.0f, std::uint16_t(i), scan.stamp_ns + i * 1000, 0});
+      auto bytes = bag::test::pointCloud2(scan, "lidar");
+      if (k == 1) bytes.resize(bytes.size() - 40);  // cut inside the point data
+      bag.write(id, scan.stamp_ns, bytes);
+    }
+  }
+  bag::BagCloudSource source(dir / "clouds.db3", "");
+  std::vector<Scan> scans;
+  while (auto c = source.next()) scans.push_back(std::move(c->scan));
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[0].stamp_ns, 1'000'000'000);
+  EXPECT_EQ(scans[1].stamp_ns, 1'200'000'000);
+  EXPECT_EQ(scans[1].size(), 5u);
+  EXPECT_EQ(scans[1].offset_ns[4], 4000u) << "per-point times from t";
+  EXPECT_EQ(source.stats().malformed, 1u);
+  EXPECT_NE(source.warning().find("1 malformed messages dropped, last: " + (dir / "clouds.db3").string() +
+                                  ": /points message at log time 1100000000"),
+            std::string::npos)
+      << source.warning();
 }
 
 /// poses.csv rows (timestamp_ns, index, px py pz, qw qx qy qz) as nav_msgs/Odometry and as /tf map ->
