@@ -29,6 +29,14 @@ config::RigConfig loadRig(const std::string& path) {
     throw CommandFailed(kExitConfig, e.what());
   }
   for (const auto& sensor : rig.sensors) {
+    if (sensor.model == pipeline::kPointCloud2Model) {  // decoded scans from a bag: no decoder to build
+      if (!sensor.source.topic)
+        throw CommandFailed(kExitConfig, config::ConfigError(sensor.where, "sensor '" + sensor.name + "': model " +
+                                                                               pipeline::kPointCloud2Model +
+                                                                               " needs a bag topic (source: {topic: ...})")
+                                             .what());
+      continue;
+    }
     try {
       (void)drivers::makeDecoder(pipeline::decoderConfigFor(sensor));
     } catch (const std::exception& e) {

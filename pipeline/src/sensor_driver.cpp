@@ -67,7 +67,10 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
       live_(!input.pcap && !input.bag),
       rate_(input.rate) {
   try {
-    decoder_ = drivers::makeDecoder(decoderConfigFor(sensor));
+    const bool cloud_model = sensor.model == kPointCloud2Model;
+    if (!cloud_model) decoder_ = drivers::makeDecoder(decoderConfigFor(sensor));
+    if (cloud_model && !input.bag)
+      throw std::runtime_error(std::string("model ") + kPointCloud2Model + " reads a bag's PointCloud2 topic (--bag)");
     if (input.bag) {
       // The topic and its form from a first look at the bag; each source then streams its own copy.
       const std::string wanted = !input.topic.empty() ? input.topic : sensor.source.topic.value_or("");
@@ -78,6 +81,9 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
         clouds_ = std::make_unique<bag::BagCloudSource>(*input.bag, topic.name);
         return;
       }
+      if (cloud_model)
+        throw std::runtime_error(std::string("model ") + kPointCloud2Model + " needs a PointCloud2 topic; " + bag_topic_ +
+                                 " holds packets: give the lidar's model");
       raw_source_ = std::make_unique<bag::BagPacketSource>(*input.bag, topic.name);
       source_ = std::make_unique<drivers::PacedSource>(*raw_source_, input.rate, stop_);
     } else if (sensor.source.port == 0) {

@@ -7,11 +7,15 @@
 
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <chrono>
 #include <fstream>
 #include <regex>
 #include <sstream>
 
 #include "bag_from_recording.hpp"
+#include "rigcal/bag/bag_cloud_source.hpp"
 #include "rigcal/bag/tf_tree.hpp"
 #include "run_command.hpp"
 #include "sanitizers.hpp"
@@ -71,7 +75,7 @@ class BagPipeline : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     g = new Recording;
-    const auto sim = runRigcal({"sim", "--scenario", "parking-lot", "--duration", kSanitized ? "1.5" : "6", "--out",
+    const auto sim = runRigcal({"sim", "--scenario", "parking-lot", "--duration", kSanitized ? "1.5" : "4", "--out",
                                 g->dir.path().string()});
     if (sim.exit_code != 0) {
       g->error = sim.err;
@@ -132,7 +136,7 @@ TEST_F(BagPipeline, MapFromPacketBagEqualsMapFromPcapAndPointCloud2BagFollowsThe
   const auto from_packets = runRigcal(args);
   ASSERT_EQ(from_packets.exit_code, 0) << from_packets.err;
   const auto pcap_rows = trajectoryRows(out / "pcap");
-  ASSERT_GT(pcap_rows.size(), kSanitized ? 3u : 30u);
+  ASSERT_GT(pcap_rows.size(), kSanitized ? 3u : 25u);
   // The same payloads and stamps: the same frames, bit for bit. The pipeline's last frames depend on how
   // the driver threads reach the end of input (two runs of the same pcap differ there too, by 1-2 frames
   // of 70 measured), so the common run is compared, and it must be nearly all of it.
@@ -172,12 +176,46 @@ TEST_F(BagPipeline, InitialExtrinsicsFromTheBagsTfStaticAreComposedToBaseLink) {
   // The inverse direction walks the same tree.
   EXPECT_LT((tree.lookup("front_left", "base_link").matrix() - expected.inverse().matrix()).cwiseAbs().maxCoeff(), 1e-12);
 
-  // Through the binary: the frames used are named, a missing frame lists the tree's frames.
-  std::ofstream(g->dir / "rig_from_bag.yaml") << rigWithTopics(readText(g->dir / "rig.yaml"), "points",
-                                                             "initial_extrinsics: from_bag\n");
+  // Through the binary: the frames used are named, a missing frame lists the tree's frames. The frame
+  // comes from each topic's first cloud; a small bag (the same /tf_static, two tiny clouds per sensor) is
+  // enough: the extrinsics are resolved before any scan is mapped.
   TempDir out;
-  const auto ok = runRigcal({"map", "--config", (g->dir / "rig_from_bag.yaml").string(), "--bag",
-                             g->clouds_bag.string(), "--out", out.path().string()});
+  const fs::path small = out / "small.db3";
+  {
+    SqliteBagWriter bag(small);
+    std::vector<bag::test::TfEdge> edges;
+    for (const auto& name : {"sensor_kit_base_link", "top", "front_left", "front_right"}) {
+      std::vector<std::string> chain;
+      const Pose T_parent_child = tree.lookup(name == std::string("sensor_kit_base_link") ? "base_link"
+                                                                                           : "sensor_kit_base_link",
+                                              name, &chain);
+      edges.push_back({chain.front(), name, T_parent_child});
+    }
+    bag::test::writeTfStatic(bag, 1, edges);
+    for (const auto& s : g->rig.sensors) {
+      const int id = bag.topic(topicOf(s.name, "points"), "sensor_msgs/msg/PointCloud2");
+      for (int k = 0; k < 2; ++k) {
+        Scan scan;
+        scan.stamp_ns = 1'700'000'000'000'000'000 + k * 100'000'000;
+        for (int i = 0; i < 10; ++i) scan.push_back({float(i), 1.0f, 0.5f, 1.0f, std::uint16_t(i), scan.stamp_ns, 0});
+        bag.write(id, scan.stamp_ns, bag::test::pointCloud2(scan, s.name));
+      }
+    }
+  }
+  // Decoded clouds need no packet model: `model: PointCloud2` (no calibration or metadata file).
+  std::ofstream(g->dir / "rig_from_bag.yaml") << std::regex_replace(
+      rigWithTopics(readText(g->dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
+      std::regex("model: \\S+"), "model: PointCloud2");
+  const auto checked = runRigcal({"check-config", (g->dir / "rig_from_bag.yaml").string()});
+  EXPECT_EQ(checked.exit_code, 0) << checked.err;
+  EXPECT_NE(checked.out.find("topic /sensing/lidar/top/points  (initial extrinsic from_bag)"), std::string::npos)
+      << checked.out;
+  const auto pcap_for_clouds = runRigcal({"map", "--config", (g->dir / "rig_from_bag.yaml").string(), "--pcap",
+                                          g->pcap.string(), "--out", out.path().string()});
+  EXPECT_EQ(pcap_for_clouds.exit_code, 2) << pcap_for_clouds.err;
+  EXPECT_NE(pcap_for_clouds.err.find("initial_extrinsics from_bag needs --bag"), std::string::npos) << pcap_for_clouds.err;
+  const auto ok = runRigcal({"map", "--config", (g->dir / "rig_from_bag.yaml").string(), "--bag", small.string(),
+                             "--out", out.path().string()});
   EXPECT_NE(ok.err.find("initial extrinsic of 'front_left' from the bag's tf: base_link -> sensor_kit_base_link -> "
                         "front_left"),
             std::string::npos)
@@ -186,8 +224,8 @@ TEST_F(BagPipeline, InitialExtrinsicsFromTheBagsTfStaticAreComposedToBaseLink) {
   rig = std::regex_replace(rig, std::regex("topic: /sensing/lidar/front_right/points\\}"),
                            "topic: /sensing/lidar/front_right/points, frame: front_right_optical}");
   std::ofstream(g->dir / "rig_bad_frame.yaml") << rig;
-  const auto bad = runRigcal({"map", "--config", (g->dir / "rig_bad_frame.yaml").string(), "--bag",
-                              g->clouds_bag.string(), "--out", out.path().string()});
+  const auto bad = runRigcal({"map", "--config", (g->dir / "rig_bad_frame.yaml").string(), "--bag", small.string(),
+                              "--out", out.path().string()});
   EXPECT_EQ(bad.exit_code, 4) << bad.err;
   EXPECT_NE(bad.err.find("initial extrinsic of 'front_right' from_bag: frame front_right_optical is not in the tf "
                          "tree; its frames: base_link, front_left, front_right, sensor_kit_base_link, top"),
@@ -250,6 +288,165 @@ TEST_F(BagPipeline, DriverPublishesTheBagsScansAsThePcaps) {
   ASSERT_GT(published(pcap), 3);
   EXPECT_EQ(published(packets), published(pcap)) << packets.out;
   EXPECT_EQ(published(clouds), int(g->clouds["front_left"])) << clouds.out;
+}
+
+std::vector<std::string> simTopics(const config::RigConfig& rig, const char* form) {
+  std::vector<std::string> args;
+  for (const auto& s : rig.sensors) args.insert(args.end(), {"--topic", s.name + "=/" + s.name + "/" + form});
+  return args;
+}
+
+/// `rigcal sim --format both` writes the recording as a pcap and as two MCAP bags (bagwrite's writer):
+/// the packet MCAP maps as the pcap, row for row; the PointCloud2 MCAP (the simulated sweeps) follows the
+/// same path within 5 mm.
+TEST(BagSimMcap, MapFromTheSimulatorsMcapsFollowsThePcap) {
+  TempDir dir;
+  const auto sim = runRigcal({"sim", "--scenario", "parking-lot", "--duration", kSanitized ? "1.5" : "4", "--format",
+                              "both", "--out", (dir / "sim").string()});
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const config::RigConfig rig = config::loadRigConfig(dir / "sim" / "rig.yaml");
+  const auto map = [&](std::vector<std::string> input, const char* out) {
+    std::vector<std::string> args{"map", "--config", (dir / "sim" / "rig.yaml").string(), "--out", (dir / out).string()};
+    args.insert(args.end(), input.begin(), input.end());
+    const auto r = runRigcal(args);
+    EXPECT_EQ(r.exit_code, 0) << out << ": " << r.err;
+    return trajectoryRows(dir / out);
+  };
+  const auto pcap = map({"--pcap", (dir / "sim" / "recording.pcap").string()}, "pcap");
+  auto packets_args = simTopics(rig, "packets");
+  packets_args.insert(packets_args.begin(), {"--bag", (dir / "sim" / "recording.mcap").string()});
+  const auto packets = map(packets_args, "packets");
+  auto points_args = simTopics(rig, "points");
+  points_args.insert(points_args.begin(), {"--bag", (dir / "sim" / "recording_points.mcap").string()});
+  const auto points = map(points_args, "points");
+  ASSERT_GT(pcap.size(), kSanitized ? 3u : 25u);
+  const std::size_t common = std::min(pcap.size(), packets.size());
+  EXPECT_GE(common + kEndFrames, std::max(pcap.size(), packets.size()));
+  for (std::size_t i = 0; i + kEndFrames < common; ++i) EXPECT_EQ(packets[i], pcap[i]) << "row " << i;
+  // The simulator writes every sweep it cast; the pcap's decoder completes a few fewer (the first and last,
+  // cut by the capture's ends): the PointCloud2 run may map a few more frames at the end.
+  const std::size_t cloud_common = std::min(pcap.size(), points.size());
+  EXPECT_GE(points.size() + kEndFrames, pcap.size());
+  for (std::size_t i = 0; i + kEndFrames < cloud_common; ++i) {
+    std::vector<std::string> a, b;
+    std::istringstream sa(pcap[i]), sb(points[i]);
+    for (std::string f; std::getline(sa, f, ',');) a.push_back(f);
+    for (std::string f; std::getline(sb, f, ',');) b.push_back(f);
+    ASSERT_GE(b.size(), 8u);
+    EXPECT_EQ(a[1], b[1]) << "row " << i;
+    for (std::size_t k = 5; k < 8; ++k) EXPECT_NEAR(std::stod(a[k]), std::stod(b[k]), 5e-3) << "row " << i;
+  }
+}
+
+/// The whole parking-lot preset calibrated three ways: from its pcap, from its packet MCAP, and from its
+/// PointCloud2 MCAP with `initial_extrinsics: from_bag` (its /tf_static holds rig.yaml's guesses); each
+/// within the preset's bounds of the truth (1 cm, 0.05°, as calibrate_presets_test).
+/// Measured (Release, 2 shared cores at load ~8, 380 s in all), errors from the 30 cm / 5° guesses:
+///   pcap     front_left 0.342 cm 0.006°, front_right 0.429 cm 0.007°, base z 0.025 cm roll/pitch 0.032°
+///   packets  front_left 0.343 cm 0.006°, front_right 0.393 cm 0.005°, base z 0.006 cm roll/pitch 0.037°
+///   points   front_left 0.339 cm 0.008°, front_right 0.467 cm 0.009°, base z 0.013 cm roll/pitch 0.034°
+/// On that busy machine the 10 s deadline let each run confirm only 1-4 of 10 frames: exit 6 (unverified),
+/// alike for all three inputs; the comparison with the truth is the criterion here.
+TEST(BagSimMcapLong, ParkingLotCalibratedFromItsMcapsAsFromItsPcap) {
+  if (kSanitized || std::getenv("RIGCAL_LONG_TESTS") == nullptr) GTEST_SKIP() << "long test: RIGCAL_LONG_TESTS=1 (Release)";
+  TempDir dir;
+  const fs::path sim_dir = dir / "sim";
+  const auto sim = runRigcal({"sim", "--scenario", "parking-lot", "--format", "both", "--out", sim_dir.string()});
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const config::RigConfig rig = config::loadRigConfig(sim_dir / "rig.yaml");
+  std::ofstream(sim_dir / "rig_from_bag.yaml") << std::regex_replace(
+      rigWithTopics(readText(sim_dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
+      std::regex("/sensing/lidar/(\\w+)/points"), "/$1/points");
+  const auto calibrate = [&](const std::string& config, std::vector<std::string> input, const char* out) {
+    std::vector<std::string> args{"calibrate", "--config", config, "--out", (dir / out).string()};
+    args.insert(args.end(), input.begin(), input.end());
+    const auto r = runRigcal(args);
+    std::printf("%s:\n%s", out, r.out.c_str());
+    EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 6) << out << ": " << r.err;
+    const auto compared = runRigcal({"compare", "--truth", (sim_dir / "truth.yaml").string(), "--result",
+                                     (dir / out / "calibration.yaml").string(), "--initial",
+                                     (sim_dir / "rig.yaml").string(), "--max-cm", "1", "--max-deg", "0.05"});
+    std::printf("%s", compared.out.c_str());
+    EXPECT_EQ(compared.exit_code, 0) << out << ": " << compared.out << compared.err;
+  };
+  calibrate((sim_dir / "rig.yaml").string(), {"--pcap", (sim_dir / "recording.pcap").string()}, "pcap");
+  auto packets = simTopics(rig, "packets");
+  packets.insert(packets.begin(), {"--bag", (sim_dir / "recording.mcap").string()});
+  calibrate((sim_dir / "rig.yaml").string(), packets, "packets");
+  calibrate((sim_dir / "rig_from_bag.yaml").string(), {"--bag", (sim_dir / "recording_points.mcap").string()},
+            "points");
+}
+
+// A PointCloud2 message that does not decode is counted and dropped; the clouds around it still arrive.
+TEST(BagCloudSource, AMalformedCloudIsDroppedAndTheOthersKept) {
+  TempDir dir;
+  {
+    SqliteBagWriter bag(dir / "clouds.db3");
+    const int id = bag.topic("/points", "sensor_msgs/msg/PointCloud2");
+    for (int k = 0; k < 3; ++k) {
+      Scan scan;
+      scan.stamp_ns = 1'000'000'000 + k * 100'000'000;
+      for (int i = 0; i < 5; ++i)
+        scan.push_back({float(i + 1), 0.5f, 0.25f, 2.0f, std::uint16_t(i), scan.stamp_ns + i * 1000, 0});
+      auto bytes = bag::test::pointCloud2(scan, "lidar");
+      if (k == 1) bytes.resize(bytes.size() - 40);  // cut inside the point data
+      bag.write(id, scan.stamp_ns, bytes);
+    }
+  }
+  bag::BagCloudSource source(dir / "clouds.db3", "");
+  std::vector<Scan> scans;
+  while (auto c = source.next()) scans.push_back(std::move(c->scan));
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[0].stamp_ns, 1'000'000'000);
+  EXPECT_EQ(scans[1].stamp_ns, 1'200'000'000);
+  EXPECT_EQ(scans[1].size(), 5u);
+  EXPECT_EQ(scans[1].offset_ns[4], 4000u) << "per-point times from t";
+  EXPECT_EQ(source.stats().malformed, 1u);
+  EXPECT_NE(source.warning().find("1 malformed messages dropped, last: " + (dir / "clouds.db3").string() +
+                                  ": /points message at log time 1100000000"),
+            std::string::npos)
+      << source.warning();
+}
+
+// --rate 1 on a PointCloud2 topic: each cloud is handed on at its log time (offset from the first), as
+// PacedSource paces a pcap's packets; --rate max does not wait.
+TEST(BagCloudSource, RecordedRatePacesCloudsByTheirLogTime) {
+  TempDir dir;
+  {
+    SqliteBagWriter bag(dir / "clouds.db3");
+    const int id = bag.topic("/points", "sensor_msgs/msg/PointCloud2");
+    for (int k = 0; k < 4; ++k) {
+      Scan scan;
+      scan.stamp_ns = 1'000'000'000 + k * 100'000'000;
+      for (int i = 0; i < 5; ++i) scan.push_back({float(i + 1), 0.5f, 0.25f, 2.0f, std::uint16_t(i), scan.stamp_ns, 0});
+      bag.write(id, scan.stamp_ns, bag::test::pointCloud2(scan, "lidar"));
+    }
+  }
+  config::SensorConfig sensor;
+  sensor.name = "lidar";
+  sensor.model = pipeline::kPointCloud2Model;
+  const auto run = [&](double rate) {
+    pipeline::DriverInput input;
+    input.bag = dir / "clouds.db3";
+    input.rate = rate;
+    const std::atomic<bool> stop{false};
+    std::vector<std::pair<std::string, double>> got;
+    const auto t0 = std::chrono::steady_clock::now();
+    pipeline::SensorDriver driver(sensor, input, stop, [&](Scan&& scan) {
+      got.emplace_back(scan.sensor_id, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    });
+    driver.run();
+    return got;
+  };
+  const auto paced = run(1.0);
+  ASSERT_EQ(paced.size(), 4u);
+  EXPECT_EQ(paced[0].first, "lidar");
+  const auto fast = run(0.0);
+  ASSERT_EQ(fast.size(), 4u);
+  if (kWallClockAsserted) {
+    EXPECT_GE(paced.back().second - paced.front().second, 0.29) << "3 gaps of 100 ms";
+    EXPECT_LT(fast.back().second, 0.25);
+  }
 }
 
 /// poses.csv rows (timestamp_ns, index, px py pz, qw qx qy qz) as nav_msgs/Odometry and as /tf map ->

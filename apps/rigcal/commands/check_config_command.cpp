@@ -26,6 +26,11 @@ void addCheckConfigCommand(CLI::App& app) {
                                         s.name) != rig.roles.calibration_lidars.end();
       std::cout << "  " << std::left << std::setw(12) << s.name << std::setw(14) << s.model << "port "
                 << std::setw(6) << s.source.port
+                << (s.source.topic ? "topic " + *s.source.topic + "  " : std::string())
+                << (std::find(rig.extrinsics_from_bag.begin(), rig.extrinsics_from_bag.end(), s.name) !=
+                            rig.extrinsics_from_bag.end()
+                        ? "(initial extrinsic from_bag)  "
+                        : "")
                 << (s.name == rig.roles.mapping_lidar ? "mapping    " : calibrated ? "calibration" : "other      ")
                 << std::fixed << std::setprecision(3) << "  xyz " << v.x << ' ' << v.y << ' ' << v.z
                 << "  rpy " << v.roll << ' ' << v.pitch << ' ' << v.yaw << '\n';

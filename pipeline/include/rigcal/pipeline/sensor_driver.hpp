@@ -31,6 +31,12 @@ struct DriverInput {
   std::string topic;
 };
 
+/// The model of a sensor whose scans come decoded, as a bag's sensor_msgs/PointCloud2 topic: no packet
+/// decoder (nor calibration / metadata file) is needed.
+inline constexpr const char* kPointCloud2Model = "PointCloud2";
+/// Points per scan a PointCloud2 sensor's ring slot holds: an OS-128 at 2048 columns, dual return.
+inline constexpr std::size_t kMaxPointCloud2Points = std::size_t(1) << 19;
+
 /// The decoder settings of a rig sensor.
 drivers::DecoderConfig decoderConfigFor(const config::SensorConfig& sensor);
 
@@ -45,7 +51,9 @@ class SensorDriver {
 
   /// Runs until the pcap / bag ends or `stop` is set; calls `idle` whenever a live source timed out.
   void run(const std::function<void()>& idle = {});
-  [[nodiscard]] std::size_t maxPointsPerScan() const { return decoder_->maxPointsPerScan(); }
+  [[nodiscard]] std::size_t maxPointsPerScan() const {
+    return decoder_ ? decoder_->maxPointsPerScan() : kMaxPointCloud2Points;
+  }
   [[nodiscard]] const drivers::AssemblerStats& assemblerStats() const { return assembler_.stats(); }
   [[nodiscard]] const drivers::SourceStats& sourceStats() const;
   [[nodiscard]] std::string warning() const;
