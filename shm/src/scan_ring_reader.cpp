@@ -11,6 +11,7 @@
 #include "rigcal/shm/ring_segment.hpp"
 #include "memory_orders.hpp"
 #include "segment.hpp"
+#include "sigbus_guard.hpp"
 
 namespace rigcal::shm {
 
@@ -50,6 +51,7 @@ struct ScanRingReader::Impl {
   void detach();
   [[nodiscard]] bool shrunk() const noexcept;
   void requireIntact();
+  [[noreturn]] void reportTruncated(const char* when);
   void claimRecord();
   void releaseRecord();
   void publishRecord();
@@ -100,7 +102,10 @@ bool ScanRingReader::Impl::shrunk() const noexcept {
 }
 
 void ScanRingReader::Impl::requireIntact() {
-  if (!shrunk()) return;
+  if (shrunk()) reportTruncated("while being read");
+}
+
+void ScanRingReader::Impl::reportTruncated(const char* when) {
   const std::uint64_t mapped = segment.mappedBytes();
   struct stat st {};
   const long long now = ::fstat(segment.fd(), &st) == 0 ? st.st_size : -1;
@@ -108,7 +113,7 @@ void ScanRingReader::Impl::requireIntact() {
   detach();
   throw RingError(RingError::Kind::kCorrupted, "shared-memory ring '" + name + "' was truncated to " +
                                                    std::to_string(now) + " of its " + std::to_string(mapped) +
-                                                   " bytes while being read: detached from it");
+                                                   " bytes " + when + ": detached from it");
 }
 
 void ScanRingReader::Impl::claimRecord() {
@@ -210,13 +215,21 @@ ReadStatus ScanRingReader::read(Scan& out, std::chrono::nanoseconds timeout, Sca
     }
     m.requireIntact();
     RingHeader& h = m.view.header();
-    if (const std::uint64_t e = h.epoch.load(kAcquire); e != m.epoch) {  // a new writer took over in place
+    // A truncation after requireIntact's check, while the header or a slot is being read, is a SIGBUS:
+    // caught here (sigbus_guard.hpp) and reported like one seen before the read.
+    std::uint64_t e = 0;
+    auto load_epoch = [&] { e = h.epoch.load(kAcquire); };
+    if (!detail::runCatchingSigbus(load_epoch)) m.reportTruncated("while its header was read (SIGBUS caught)");
+    if (e != m.epoch) {  // a new writer took over in place
       ++m.stats.writer_restarts;
       m.epoch = e;
       m.status = evaluateWriter(h, m.options.stall_after);
       m.gone_reported = false;
     }
-    if (readNext(m.view, m.next_index, out, meta, m.counters) == ReadOutcome::kScan) {
+    ReadOutcome outcome = ReadOutcome::kEmpty;
+    auto copy = [&] { outcome = readNext(m.view, m.next_index, out, meta, m.counters); };
+    if (!detail::runCatchingSigbus(copy)) m.reportTruncated("while a slot was copied (SIGBUS caught)");
+    if (outcome == ReadOutcome::kScan) {
       if (out.sensor_id != m.options.sensor) out.sensor_id = m.options.sensor;
       ++m.stats.scans;
       m.stats.points += out.size();
