@@ -1,6 +1,7 @@
 #include "rigcal/pipeline/pipeline.hpp"
 
 #include "pipeline_impl.hpp"
+#include "rigcal/pipeline/clock_offset_estimate.hpp"
 
 namespace rigcal::pipeline {
 
@@ -176,10 +177,19 @@ std::vector<SensorInput> Pipeline::inputs() const {
     in.lost_packets = a.lost_packets;
     in.malformed = a.malformed + src.malformed;
     in.late_dropped = a.late_dropped;
+    in.reordered = a.reordered;
+    in.foreign_packets = drv.foreignPackets().packets;
+    if (in.foreign_packets > 0) {
+      const config::SensorConfig& sc = impl_->rig.sensor(in.sensor);
+      in.foreign = drv.foreignPackets().describe(sc.model, sc.source.port);
+    }
     in.fragments_dropped = src.fragments_dropped;
     in.last_error = a.last_error;
     in.warning = drv.warning();
     in.clock_lag_ms = drv.clockLagMs();
+    const ClockLag lag = clockLagOf(drv.clockLagSamplesMs());
+    in.clock_lag_sigma_ms = lag.sigma_ms;
+    in.clock_lag_sweeps = lag.sweeps;
     out.push_back(std::move(in));
   }
   return out;

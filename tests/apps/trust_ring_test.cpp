@@ -153,6 +153,26 @@ TEST_F(TrustRing, ASecondUserCannotReadOurRing) {
   driver.wait();
 }
 
+// A Velodyne stream on the port of a sensor the rig says is a Hesai: the driver holds those packets back
+// from its decoder, counts them and says once what they are and where they came from.
+TEST_F(TrustRing, PacketsOfAnotherModelAreCountedAndNamed) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  std::ofstream(rig_) << "sensors:\n  - name: roof\n    model: PandarXT32\n    source: {port: 2368}\n"
+                         "roles:\n  mapping_lidar: roof\n";
+  const CommandResult r = runRigcal(driverArgs(pcap));
+  EXPECT_LT(r.exit_code, 128) << r.err;
+  const std::string line = "warning: sensor 'roof': ";
+  const auto at = r.err.find(line);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const std::string warning = r.err.substr(at, r.err.find('\n', at) - at);
+  EXPECT_NE(warning.find(" packets of another model (Velodyne, 1206 B) on its port 2368 (it is a PandarXT32), the "
+                         "last from "),
+            std::string::npos)
+      << warning;
+  EXPECT_EQ(r.err.find(line, at + 1), std::string::npos) << "one line: " << r.err;
+  EXPECT_NE(r.out.find(": 0 scans published, 0 too large for a slot; 0 packets, 0 malformed"), std::string::npos) << "none reached the decoder: " << r.out;
+}
+
 // A `rigcal driver` killed and restarted under `rigcal map --shm --wait-for-writers`: map says the writer
 // died, follows the restarted driver's new epoch with the gap, and is still running to read it.
 TEST_F(TrustRing, MapFollowsARestartedDriver) {

@@ -131,11 +131,18 @@ struct SensorInput {
   std::uint64_t lost_packets = 0;       // gaps in the sensor's packet sequence
   std::uint64_t malformed = 0;          // packets and frames dropped as malformed (decoder and source)
   std::uint64_t late_dropped = 0;       // packets older than one already assembled
+  std::uint64_t reordered = 0;          // packets that came after a later one (put back in order unless late)
+  std::uint64_t foreign_packets = 0;    // packets of another model on its port, ignored
+  std::string foreign;                  // ForeignPackets::describe(), when foreign_packets > 0
   std::uint64_t fragments_dropped = 0;  // IPv4 fragments never completed (of every sensor in the capture)
   std::string last_error;               // the latest malformed packet's reason
   std::string warning;                  // the capture ended abnormally (e.g. truncated mid-record)
   std::optional<double> clock_lag_ms;   // SensorDriver::clockLagMs()
-  [[nodiscard]] bool damaged() const { return lost_packets + malformed + late_dropped > 0 || !warning.empty(); }
+  double clock_lag_sigma_ms = 0.0;      // the standard error of clock_lag_ms (ClockLag::sigma_ms)
+  std::size_t clock_lag_sweeps = 0;
+  [[nodiscard]] bool damaged() const {
+    return lost_packets + malformed + late_dropped + foreign_packets > 0 || !warning.empty();
+  }
 };
 
 class Pipeline {

@@ -12,6 +12,7 @@
 
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
+#include "rigcal/drivers/packet_family.hpp"
 #include "rigcal/drivers/packet_source.hpp"
 #include "rigcal/drivers/scan_assembler.hpp"
 
@@ -20,6 +21,16 @@ namespace rigcal::pipeline {
 struct DriverInput {
   std::optional<std::filesystem::path> pcap;  // empty: live UDP on the sensor's port
   double rate = 0.0;                          // pcap only: 1.0 = recorded timing, 0 = as fast as possible
+};
+
+/// Packets of another vendor's model that reached a sensor's port or filter (drivers::recognizePacket).
+struct ForeignPackets {
+  std::uint64_t packets = 0;
+  drivers::PacketFamily family = drivers::PacketFamily::kUnknown;  // of the last one
+  std::size_t bytes = 0;                                           // its size
+  drivers::UdpEndpoint last_source;
+  /// One line: how many, what they look like, from where (for the sensor `model` on `port`).
+  [[nodiscard]] std::string describe(const std::string& model, std::uint16_t port) const;
 };
 
 /// The decoder settings of a rig sensor.
@@ -44,6 +55,10 @@ class SensorDriver {
   /// time of the sweep's last point), in ms; nullopt before the first sweep. Sensors whose clocks agree
   /// show the same lag within the network's and the assembler's few ms (see SensorClockCheck).
   [[nodiscard]] std::optional<double> clockLagMs() const;
+  /// Packets of another model held back from the decoder (complete once run() returned).
+  [[nodiscard]] const ForeignPackets& foreignPackets() const;
+  /// The per-sweep lags behind clockLagMs() (their spread gives its uncertainty).
+  [[nodiscard]] std::vector<double> clockLagSamplesMs() const;
 
  private:
   config::SensorConfig sensor_;
