@@ -52,6 +52,7 @@ struct ScanRingReader::Impl {
   [[nodiscard]] bool shrunk() const noexcept;
   void requireIntact();
   [[noreturn]] void reportTruncated(const char* when);
+  std::unique_ptr<detail::TruncationShield> shield;  // over the mapping while attached
   void claimRecord();
   void releaseRecord();
   void publishRecord();
@@ -68,6 +69,7 @@ bool ScanRingReader::Impl::tryAttach(bool use_start_option) {
   if (checkHeader(seg->base(), seg->mappedBytes(), name) == HeaderState::kUninitialised) return false;
   segment = std::move(*seg);
   view = RingView(segment.base(), segment.mappedBytes());
+  shield = std::make_unique<detail::TruncationShield>(segment.base(), segment.mappedBytes());
   attached = true;
   const RingHeader& h = view.header();
   if (ever_attached) {  // a new segment under our name: a new writer
@@ -89,7 +91,8 @@ bool ScanRingReader::Impl::tryAttach(bool use_start_option) {
 void ScanRingReader::Impl::detach() {
   releaseRecord();
   view = RingView();
-  segment = detail::Segment();
+  shield.reset();
+  segment = detail::Segment();  // unmaps (the zero pages too, if the shield tripped)
   attached = false;
 }
 
@@ -102,7 +105,9 @@ bool ScanRingReader::Impl::shrunk() const noexcept {
 }
 
 void ScanRingReader::Impl::requireIntact() {
-  if (shrunk()) reportTruncated("while being read");
+  if (shrunk() || (shield && shield->tripped()))
+    reportTruncated(shield && shield->tripped() ? "while being read (SIGBUS caught: zero pages mapped in its place)"
+                                                : "while being read");
 }
 
 void ScanRingReader::Impl::reportTruncated(const char* when) {
@@ -215,21 +220,15 @@ ReadStatus ScanRingReader::read(Scan& out, std::chrono::nanoseconds timeout, Sca
     }
     m.requireIntact();
     RingHeader& h = m.view.header();
-    // A truncation after requireIntact's check, while the header or a slot is being read, is a SIGBUS:
-    // caught here (sigbus_guard.hpp) and reported like one seen before the read.
-    std::uint64_t e = 0;
-    auto load_epoch = [&] { e = h.epoch.load(kAcquire); };
-    if (!detail::runCatchingSigbus(load_epoch)) m.reportTruncated("while its header was read (SIGBUS caught)");
-    if (e != m.epoch) {  // a new writer took over in place
+    // A truncation after requireIntact's check turns the mapping into zero pages (TruncationShield): this
+    // pass reads nothing, the next check reports it.
+    if (const std::uint64_t e = h.epoch.load(kAcquire); e != m.epoch) {  // a new writer took over in place
       ++m.stats.writer_restarts;
       m.epoch = e;
       m.status = evaluateWriter(h, m.options.stall_after);
       m.gone_reported = false;
     }
-    ReadOutcome outcome = ReadOutcome::kEmpty;
-    auto copy = [&] { outcome = readNext(m.view, m.next_index, out, meta, m.counters); };
-    if (!detail::runCatchingSigbus(copy)) m.reportTruncated("while a slot was copied (SIGBUS caught)");
-    if (outcome == ReadOutcome::kScan) {
+    if (readNext(m.view, m.next_index, out, meta, m.counters) == ReadOutcome::kScan) {
       if (out.sensor_id != m.options.sensor) out.sensor_id = m.options.sensor;
       ++m.stats.scans;
       m.stats.points += out.size();

@@ -1,21 +1,34 @@
 #pragma once
-// A reader copies slots out of a mapping whose size another process (of the ring's owner: the mode is
-// 0600) can cut at any moment. The fstat check before each read (ScanRingReader::Impl::requireIntact)
-// leaves a window: a truncation during the copy makes the next touched page raise SIGBUS, which kills the
-// process. This guard turns a SIGBUS raised inside `fn` on the calling thread into a false return; a SIGBUS
-// anywhere else gets the disposition that was there before (default: the process dies, as without it).
+// A reader maps a ring whose size another process (of the ring's owner: the mode is 0600) can cut at any
+// moment. The fstat check before each read (ScanRingReader::Impl::requireIntact) leaves a window: a
+// truncation after it makes the next touched page past the new end raise SIGBUS, which kills the process
+// (a slot copy, the header's liveness fields, the reader's own record: any of them).
 //
-// `fn` must only touch memory and trivially destructible locals (it is left by siglongjmp): the ring's copy
-// loops qualify; anything that allocates, locks or owns resources does not.
+// A TruncationShield makes that impossible for one mapping: on a SIGBUS inside it, the handler replaces the
+// whole mapping with private zero pages (mmap MAP_FIXED, async-signal-safe) and returns, so the faulting
+// access and everything after it read zeros, which the ring protocol already treats as nothing published
+// (sequence 0: a torn read; write index 0: empty; no writer). The next size check reports the truncation.
+// A SIGBUS outside every shielded mapping keeps the disposition it had (default: the process dies).
+#include <cstddef>
+
 namespace rigcal::shm::detail {
 
-/// Runs fn(context). False when it was cut short by a SIGBUS (a mapping lost its pages under it).
-bool runCatchingSigbus(void (*fn)(void*), void* context);
+class TruncationShield {
+ public:
+  /// Shields [base, base + bytes) until destroyed (at most kMaxShields at a time; beyond that, unshielded).
+  TruncationShield(void* base, std::size_t bytes);
+  ~TruncationShield();
+  TruncationShield(const TruncationShield&) = delete;
+  TruncationShield& operator=(const TruncationShield&) = delete;
 
-/// The lambda form: `f` is called once; same rules as above.
-template <class F>
-bool runCatchingSigbus(F& f) {
-  return runCatchingSigbus([](void* c) { (*static_cast<F*>(c))(); }, &f);
-}
+  /// True once a SIGBUS replaced the mapping with zero pages.
+  [[nodiscard]] bool tripped() const;
+  [[nodiscard]] bool active() const { return slot_ >= 0; }
+
+  static constexpr int kMaxShields = 64;
+
+ private:
+  int slot_ = -1;
+};
 
 }  // namespace rigcal::shm::detail
