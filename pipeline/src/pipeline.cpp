@@ -75,6 +75,8 @@ PipelineProgress Pipeline::progress() const {
   p.stopped_frames = m.stopped.load();
   p.lost_frames = m.lost.load();
   p.mapping_done = m.mapping_done.load();
+  p.mapping_sensor = m.sensors[0];
+  p.mapping_lost_packets = m.mapping_lost_packets.load();
   for (std::size_t i = 0; i < m.lanes.size(); ++i) {
     const LaneCounters& c = *m.lanes[i];
     LidarProgress l;
@@ -85,6 +87,7 @@ PipelineProgress Pipeline::progress() const {
     l.selected = c.selected.load();
     l.budget = m.params.lidar_calibration_max_frames;
     l.handed_over = c.handed_over.load();
+    l.lost_packets = c.lost_packets.load();
     p.lidars.push_back(l);
   }
   return p;

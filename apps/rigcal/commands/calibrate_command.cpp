@@ -213,6 +213,18 @@ void run(const CalibrateOptions& o) {
       std::cerr << "warning: " << w.str() << "\n";
     }
   }
+  if (inputs.empty()) {
+    // Scans from shared-memory rings: their drivers run elsewhere, but each scan says how many packets it
+    // lost, so the damage is still reported per sensor.
+    std::vector<std::pair<std::string, std::uint64_t>> lost{{progress_now.mapping_sensor, progress_now.mapping_lost_packets}};
+    for (const auto& l : progress_now.lidars) lost.emplace_back(l.sensor, l.lost_packets);
+    for (const auto& [sensor, n] : lost) {
+      outcome.input_summary.emplace_back(sensor + "_packets_lost", std::to_string(n));
+      if (n == 0) continue;
+      outcome.warnings.push_back(sensor + ": " + std::to_string(n) + " packets lost (as its scans from the ring say)");
+      std::cerr << "warning: " << outcome.warnings.back() << "\n";
+    }
+  }
   for (const auto& s : rig.sensors)
     if (s.time_offset_ns != 0 || s.estimate_time_offset)
       outcome.input_summary.emplace_back(s.name + "_time_offset_ns", std::to_string(s.time_offset_ns));

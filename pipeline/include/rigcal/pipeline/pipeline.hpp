@@ -59,6 +59,7 @@ struct LidarProgress {
   std::uint64_t selected = 0;    // frames the selector holds now
   int budget = 0;                // lidar_calibration_max_frames
   bool handed_over = false;      // its dataset went to the callback
+  std::uint64_t lost_packets = 0;  // the packets its scans say were lost (any input: pcap, live, rings)
 };
 
 struct PipelineProgress {
@@ -70,6 +71,8 @@ struct PipelineProgress {
   std::uint64_t stopped_frames = 0;
   std::uint64_t lost_frames = 0;
   bool mapping_done = false;  // mapping_max_frames reached: the mapper stopped by itself
+  std::string mapping_sensor;
+  std::uint64_t mapping_lost_packets = 0;  // as LidarProgress::lost_packets, for the mapping lidar
   std::vector<LidarProgress> lidars;
   /// Mean budget fill over the calibration lidars, 0..1.
   [[nodiscard]] double budgetFill() const;
