@@ -148,7 +148,8 @@ class Reader {
 
 SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
   r.requireMap(n, "a sensor");
-  r.checkKeys(n, {"name", "model", "source", "calibration", "metadata", "time_source", "cut_angle"},
+  r.checkKeys(n, {"name", "model", "source", "calibration", "metadata", "time_source", "cut_angle",
+                  "time_offset_ns"},
               "sensor");
   SensorConfig s;
   s.where = r.at(n);
@@ -200,6 +201,19 @@ SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
   if (const YAML::Node c = n["cut_angle"]) {
     s.cut_angle_deg = r.number(c, "cut_angle");
     r.inRange(c, "cut_angle", s.cut_angle_deg, 0, 360);
+  }
+  if (const YAML::Node t = n["time_offset_ns"]) {
+    // A clock more than a minute off is not a residual offset but an unsynchronised sensor.
+    constexpr long long kMaxOffsetNs = 60'000'000'000LL;
+    if (t.IsScalar() && t.Scalar() == "estimate") {
+      s.estimate_time_offset = true;
+    } else {
+      long long v = 0;
+      if (!t.IsScalar() || !YAML::convert<long long>::decode(t, v))
+        r.fail(t, "'time_offset_ns' must be an integer (nanoseconds) or 'estimate'");
+      r.inRange(t, "time_offset_ns", double(v), double(-kMaxOffsetNs), double(kMaxOffsetNs));
+      s.time_offset_ns = v;
+    }
   }
   return s;
 }

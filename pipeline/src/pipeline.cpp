@@ -1,6 +1,7 @@
 #include "rigcal/pipeline/pipeline.hpp"
 
 #include "pipeline_impl.hpp"
+#include "rigcal/pipeline/clock_offset_estimate.hpp"
 
 namespace rigcal::pipeline {
 
@@ -74,6 +75,8 @@ PipelineProgress Pipeline::progress() const {
   p.stopped_frames = m.stopped.load();
   p.lost_frames = m.lost.load();
   p.mapping_done = m.mapping_done.load();
+  p.mapping_sensor = m.sensors[0];
+  p.mapping_lost_packets = m.mapping_lost_packets.load();
   for (std::size_t i = 0; i < m.lanes.size(); ++i) {
     const LaneCounters& c = *m.lanes[i];
     LidarProgress l;
@@ -84,6 +87,7 @@ PipelineProgress Pipeline::progress() const {
     l.selected = c.selected.load();
     l.budget = m.params.lidar_calibration_max_frames;
     l.handed_over = c.handed_over.load();
+    l.lost_packets = c.lost_packets.load();
     p.lidars.push_back(l);
   }
   return p;
@@ -176,10 +180,19 @@ std::vector<SensorInput> Pipeline::inputs() const {
     in.lost_packets = a.lost_packets;
     in.malformed = a.malformed + src.malformed;
     in.late_dropped = a.late_dropped;
+    in.reordered = a.reordered;
+    in.foreign_packets = drv.foreignPackets().packets;
+    if (in.foreign_packets > 0) {
+      const config::SensorConfig& sc = impl_->rig.sensor(in.sensor);
+      in.foreign = drv.foreignPackets().describe(sc.model, sc.source.port);
+    }
     in.fragments_dropped = src.fragments_dropped;
     in.last_error = a.last_error;
     in.warning = drv.warning();
     in.clock_lag_ms = drv.clockLagMs();
+    const ClockLag lag = clockLagOf(drv.clockLagSamplesMs());
+    in.clock_lag_sigma_ms = lag.sigma_ms;
+    in.clock_lag_sweeps = lag.sweeps;
     out.push_back(std::move(in));
   }
   return out;

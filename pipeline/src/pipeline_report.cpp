@@ -34,8 +34,11 @@ std::string PipelineProgress::line() const {
   std::ostringstream o;
   o << "scans " << mapping_scans << " | kf " << keyframes << " stopped " << stopped_frames << " lost " << lost_frames;
   if (mapping_done) o << " (map full)";
+  // Packets lost show as they happen, not only in the final report.
+  if (mapping_lost_packets > 0) o << " | " << mapping_sensor << " lost " << mapping_lost_packets << " pkts";
   for (const auto& l : lidars) {
     o << " | " << l.sensor << ' ' << l.selected << '/' << l.budget << " (cand " << l.candidates << ')';
+    if (l.lost_packets > 0) o << " (lost " << l.lost_packets << " pkts)";
     if (l.handed_over) o << " done";
   }
   return o.str();

@@ -13,8 +13,13 @@ void Pipeline::Impl::ingest(Scan&& scan, int sensor, std::int64_t t0_ns) {
     unknown_sensor_scans.fetch_add(1, std::memory_order_relaxed);
     return;
   }
-  if (sensor == 0) mapping_scans.fetch_add(1, std::memory_order_relaxed);
-  else lanes[std::size_t(sensor - 1)]->scans.fetch_add(1, std::memory_order_relaxed);
+  if (sensor == 0) {
+    mapping_scans.fetch_add(1, std::memory_order_relaxed);
+    mapping_lost_packets.fetch_add(scan.missing_packets, std::memory_order_relaxed);
+  } else {
+    lanes[std::size_t(sensor - 1)]->scans.fetch_add(1, std::memory_order_relaxed);
+    lanes[std::size_t(sensor - 1)]->lost_packets.fetch_add(scan.missing_packets, std::memory_order_relaxed);
+  }
   ScanItem item{std::make_shared<Scan>(std::move(scan)), sensor, t0_ns, false};
   if (realtime) q_in.pushDropOldest(std::move(item));
   else if (!q_in.push(std::move(item))) return;

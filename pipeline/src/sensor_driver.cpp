@@ -8,6 +8,7 @@
 #include "rigcal/bag/lidar_topic.hpp"
 #include "rigcal/drivers/info_port_source.hpp"
 #include "rigcal/drivers/paced_source.hpp"
+#include "rigcal/drivers/packet_family.hpp"
 #include "rigcal/drivers/pacing.hpp"
 #include "rigcal/drivers/pcap_source.hpp"
 #include "rigcal/drivers/scan_pump.hpp"
@@ -37,21 +38,34 @@ drivers::PacketFilter filterFor(const config::SensorConfig& sensor, bool live) {
 constexpr std::size_t kMaxLags = 4096;  // sweeps kept for the clock-lag median (7 min at 10 Hz)
 }  // namespace
 
-/// Passes packets through and remembers the receive time of the last one (driver thread only).
+/// Passes packets through and remembers the receive time of the last one (driver thread only). Packets
+/// of another vendor's model (drivers::recognizePacket) are held back and counted as foreign: decoded
+/// with this sensor's layout they would be malformed at best.
 class SensorDriver::ReceiveTimeTap : public drivers::PacketSource {
  public:
-  explicit ReceiveTimeTap(drivers::PacketSource& inner) : inner_(inner) {}
+  ReceiveTimeTap(drivers::PacketSource& inner, drivers::PacketFamily own) : inner_(inner), own_(own) {}
   std::optional<drivers::UdpPacket> next() override {
     auto p = inner_.next();
+    while (p && own_ != drivers::PacketFamily::kUnknown) {
+      const drivers::PacketFamily family = drivers::recognizePacket(p->payload);
+      if (family == drivers::PacketFamily::kUnknown || family == own_) break;
+      ++foreign.packets;
+      foreign.family = family;
+      foreign.bytes = p->payload.size();
+      foreign.last_source = p->source;
+      p = inner_.next();
+    }
     if (p) last_receive_ns = p->receive_ns;
     return p;
   }
   [[nodiscard]] const drivers::SourceStats& stats() const override { return inner_.stats(); }
   [[nodiscard]] std::string warning() const override { return inner_.warning(); }
   TimeNs last_receive_ns = 0;
+  ForeignPackets foreign;
 
  private:
   drivers::PacketSource& inner_;
+  drivers::PacketFamily own_;
 };
 
 SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput& input,
@@ -60,6 +74,9 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
       on_scan_(std::move(on_scan)),
       assembler_(sensor.name, drivers::AssemblerConfig{sensor.cut_angle_deg},
                  [this](Scan&& scan) {
+                   // The rig's time_offset_ns puts this sensor's stamps on the rig's clock (before the lag
+                   // check, which then measures what is left).
+                   scan.stamp_ns -= sensor_.time_offset_ns;
                    recordLag(scan, tap_ ? tap_->last_receive_ns : 0);
                    on_scan_(std::move(scan));
                  }),
@@ -103,7 +120,7 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
       else
         source_ = std::make_unique<drivers::UdpSource>(udp);
     }
-    tap_ = std::make_unique<ReceiveTimeTap>(*source_);
+    tap_ = std::make_unique<ReceiveTimeTap>(*source_, drivers::familyOfModel(sensor.model));
   } catch (const std::exception& e) {
     throw std::runtime_error("sensor '" + sensor.name + "': " + e.what());
   }
@@ -140,6 +157,7 @@ void SensorDriver::runClouds() {
       if (!drivers::sleepUntil(last_deadline, stop_)) return;
     }
     cloud->scan.sensor_id = sensor_.name;
+    cloud->scan.stamp_ns -= sensor_.time_offset_ns;  // as for decoded packets (see the constructor)
     recordLag(cloud->scan, cloud->log_time_ns);
     on_scan_(std::move(cloud->scan));
   }
@@ -164,6 +182,20 @@ std::optional<double> SensorDriver::clockLagMs() const {
   std::vector<double> v = lags_ms_;
   std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
   return v[v.size() / 2];
+}
+
+const ForeignPackets& SensorDriver::foreignPackets() const { return tap_->foreign; }
+
+std::string ForeignPackets::describe(const std::string& model, std::uint16_t port) const {
+  return std::to_string(packets) + " packets of another model (" + drivers::toString(family) + ", " +
+         std::to_string(bytes) + " B) on its port " + std::to_string(port) + " (it is a " + model +
+         "), the last from " + drivers::formatIpv4(last_source.address) + ":" + std::to_string(last_source.port) +
+         ": ignored; is another sensor sending to this port?";
+}
+
+std::vector<double> SensorDriver::clockLagSamplesMs() const {
+  std::lock_guard lock(lag_mutex_);
+  return lags_ms_;
 }
 
 }  // namespace rigcal::pipeline

@@ -11,6 +11,7 @@
 #include "rigcal/shm/ring_segment.hpp"
 #include "memory_orders.hpp"
 #include "segment.hpp"
+#include "sigbus_guard.hpp"
 
 namespace rigcal::shm {
 
@@ -50,6 +51,8 @@ struct ScanRingReader::Impl {
   void detach();
   [[nodiscard]] bool shrunk() const noexcept;
   void requireIntact();
+  [[noreturn]] void reportTruncated(const char* when);
+  std::unique_ptr<detail::TruncationShield> shield;  // over the mapping while attached
   void claimRecord();
   void releaseRecord();
   void publishRecord();
@@ -66,6 +69,7 @@ bool ScanRingReader::Impl::tryAttach(bool use_start_option) {
   if (checkHeader(seg->base(), seg->mappedBytes(), name) == HeaderState::kUninitialised) return false;
   segment = std::move(*seg);
   view = RingView(segment.base(), segment.mappedBytes());
+  shield = std::make_unique<detail::TruncationShield>(segment.base(), segment.mappedBytes());
   attached = true;
   const RingHeader& h = view.header();
   if (ever_attached) {  // a new segment under our name: a new writer
@@ -87,7 +91,8 @@ bool ScanRingReader::Impl::tryAttach(bool use_start_option) {
 void ScanRingReader::Impl::detach() {
   releaseRecord();
   view = RingView();
-  segment = detail::Segment();
+  shield.reset();
+  segment = detail::Segment();  // unmaps (the zero pages too, if the shield tripped)
   attached = false;
 }
 
@@ -100,7 +105,12 @@ bool ScanRingReader::Impl::shrunk() const noexcept {
 }
 
 void ScanRingReader::Impl::requireIntact() {
-  if (!shrunk()) return;
+  if (shrunk() || (shield && shield->tripped()))
+    reportTruncated(shield && shield->tripped() ? "while being read (SIGBUS caught: zero pages mapped in its place)"
+                                                : "while being read");
+}
+
+void ScanRingReader::Impl::reportTruncated(const char* when) {
   const std::uint64_t mapped = segment.mappedBytes();
   struct stat st {};
   const long long now = ::fstat(segment.fd(), &st) == 0 ? st.st_size : -1;
@@ -108,7 +118,7 @@ void ScanRingReader::Impl::requireIntact() {
   detach();
   throw RingError(RingError::Kind::kCorrupted, "shared-memory ring '" + name + "' was truncated to " +
                                                    std::to_string(now) + " of its " + std::to_string(mapped) +
-                                                   " bytes while being read: detached from it");
+                                                   " bytes " + when + ": detached from it");
 }
 
 void ScanRingReader::Impl::claimRecord() {
@@ -210,6 +220,8 @@ ReadStatus ScanRingReader::read(Scan& out, std::chrono::nanoseconds timeout, Sca
     }
     m.requireIntact();
     RingHeader& h = m.view.header();
+    // A truncation after requireIntact's check turns the mapping into zero pages (TruncationShield): this
+    // pass reads nothing, the next check reports it.
     if (const std::uint64_t e = h.epoch.load(kAcquire); e != m.epoch) {  // a new writer took over in place
       ++m.stats.writer_restarts;
       m.epoch = e;

@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -96,6 +98,79 @@ TEST_F(TrustRing, SlotsAreBoundedByBytes) {
   EXPECT_EQ(small.exit_code, 0) << small.err;
   EXPECT_NE(small.out.find("(8 slots, "), std::string::npos) << small.out;
   EXPECT_NE(small.out.find(" MiB)"), std::string::npos) << small.out;
+}
+
+/// `command` run as user nobody (setpriv), through the shell; its exit code.
+int asNobody(const std::string& command) {
+  const std::string line = "setpriv --reuid=65534 --regid=65534 --clear-groups sh -c '" + command + "' 2>/dev/null";
+  const int status = std::system(line.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+// The hijack as it happens: a second, unprivileged user creates the ring's name world-writable before the
+// driver starts (no root chown, as in ARingAnotherUserCreatedIsRefused). The driver refuses it with a
+// one-line message naming the owner and the way out, and neither sizes nor writes it.
+TEST_F(TrustRing, ARingASecondUserPreCreatedIsRefused) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to run a second user (setpriv)";
+  if (std::system("setpriv --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "setpriv is needed";
+  ASSERT_EQ(asNobody("umask 0; : > " + segment().string() + " && chmod 0666 " + segment().string()), 0);
+  struct stat st {};
+  ASSERT_EQ(::stat(segment().c_str(), &st), 0);
+  ASSERT_EQ(st.st_uid, 65534u) << "the second user owns it";
+  ASSERT_EQ(st.st_mode & 07777, 0666u);
+  const CommandResult r = RigcalProcess(driverArgs(pcap)).wait();
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("belongs to uid 65534"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+  ASSERT_EQ(::stat(segment().c_str(), &st), 0);
+  EXPECT_EQ(st.st_size, 0) << "not sized or written";
+  EXPECT_EQ(st.st_uid, 65534u) << "left alone";
+}
+
+// A ring the driver created (0600) is closed to a second user: nobody cannot read, write or truncate it
+// while root's driver runs. (Root itself can read it: the check is that the mode really protects it.)
+TEST_F(TrustRing, ASecondUserCannotReadOurRing) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to run a second user (setpriv)";
+  if (std::system("setpriv --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "setpriv is needed";
+  shm::ReaderOptions r;
+  r.sensor = "roof";
+  r.name_prefix = prefix_;
+  r.start_at = shm::ReaderOptions::StartAt::kOldest;
+  shm::ScanRingReader reader(r);  // waits for the ring to appear
+  std::vector<std::string> args = driverArgs(pcap);
+  args[8] = "0.5";  // --rate: keep it alive for a while
+  RigcalProcess driver(args);
+  Scan scan;
+  ASSERT_EQ(reader.read(scan, std::chrono::seconds(30)), shm::ReadStatus::kScan);
+  EXPECT_EQ(std::system(("head -c 64 " + segment().string() + " >/dev/null").c_str()), 0) << "root reads it";
+  EXPECT_NE(asNobody("head -c 64 " + segment().string() + " >/dev/null"), 0) << "nobody read the ring";
+  EXPECT_NE(asNobody("printf x >> " + segment().string()), 0) << "nobody wrote the ring";
+  EXPECT_NE(asNobody("truncate -s 0 " + segment().string()), 0) << "nobody truncated the ring";
+  ASSERT_EQ(reader.read(scan, std::chrono::seconds(30)), shm::ReadStatus::kScan) << "the ring still works";
+  driver.kill(SIGINT);
+  driver.wait();
+}
+
+// A Velodyne stream on the port of a sensor the rig says is a Hesai: the driver holds those packets back
+// from its decoder, counts them and says once what they are and where they came from.
+TEST_F(TrustRing, PacketsOfAnotherModelAreCountedAndNamed) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  std::ofstream(rig_) << "sensors:\n  - name: roof\n    model: PandarXT32\n    source: {port: 2368}\n"
+                         "roles:\n  mapping_lidar: roof\n";
+  const CommandResult r = runRigcal(driverArgs(pcap));
+  EXPECT_LT(r.exit_code, 128) << r.err;
+  const std::string line = "warning: sensor 'roof': ";
+  const auto at = r.err.find(line);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const std::string warning = r.err.substr(at, r.err.find('\n', at) - at);
+  EXPECT_NE(warning.find(" packets of another model (Velodyne, 1206 B) on its port 2368 (it is a PandarXT32), the "
+                         "last from "),
+            std::string::npos)
+      << warning;
+  EXPECT_EQ(r.err.find(line, at + 1), std::string::npos) << "one line: " << r.err;
+  EXPECT_NE(r.out.find(": 0 scans published, 0 too large for a slot; 0 packets, 0 malformed"), std::string::npos) << "none reached the decoder: " << r.out;
 }
 
 // A `rigcal driver` killed and restarted under `rigcal map --shm --wait-for-writers`: map says the writer

@@ -102,6 +102,23 @@ TEST(LidarLidarVerdict, AClockOffsetAboveTheLimitIsUnverifiedNamingTheSensorAndT
   EXPECT_EQ(r.verdict, Verdict::kUnverified);
   EXPECT_DOUBLE_EQ(r.evidence.clock_offset_ms, -50.0);
   EXPECT_NE(r.doubt.find("front_left's packet clock is -50.0 ms off top's"), std::string::npos) << r.doubt;
+  EXPECT_NE(r.doubt.find("time_offset_ns: -50000000"), std::string::npos) << "the correction named: " << r.doubt;
+}
+
+// After a time_offset_ns the rig applied, what is left is doubted against the limit, and the correction
+// suggested is the total (what was applied plus what is left), with its uncertainty.
+TEST(LidarLidarVerdict, AResidualClockOffsetAfterTheRigsCorrectionSuggestsTheTotal) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0});
+  r.calibration_sensor = "front_left";
+  r.mapping_sensor = "top";
+  judgeLidarLidar(r, 3, 10.0);
+  r.evidence.time_offset_applied_ms = 35.0;
+  doubtClockOffset(r, 15.0, 10.0, 0.4);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_TRUE(r.evidence.clock_measured);
+  EXPECT_DOUBLE_EQ(r.evidence.clock_offset_uncertainty_ms, 0.4);
+  EXPECT_NE(r.doubt.find("(± 0.4 ms"), std::string::npos) << r.doubt;
+  EXPECT_NE(r.doubt.find("time_offset_ns: 50000000"), std::string::npos) << r.doubt;
 }
 
 }  // namespace

@@ -178,5 +178,27 @@ roles:
   EXPECT_NE(errorOf(bad).find("info_port"), std::string::npos);
 }
 
+
+// A sensor's time_offset_ns: nanoseconds its clock runs ahead of the rig's (within a minute), or `estimate`.
+TEST_F(RigConfigTest, TimeOffsetIsNanosecondsOrEstimate) {
+  std::string given = kMinimal;
+  given.replace(given.find("    source: {port: 2369"), 0, "    time_offset_ns: -35000000\n");
+  const RigConfig g = loadRigConfig(write(given));
+  EXPECT_EQ(g.sensor("left").time_offset_ns, -35'000'000);
+  EXPECT_FALSE(g.sensor("left").estimate_time_offset);
+  EXPECT_EQ(g.sensor("top").time_offset_ns, 0);
+
+  std::string estimated = kMinimal;
+  estimated.replace(estimated.find("    source: {port: 2369"), 0, "    time_offset_ns: estimate\n");
+  EXPECT_TRUE(loadRigConfig(write(estimated)).sensor("left").estimate_time_offset);
+
+  std::string words = kMinimal;
+  words.replace(words.find("    source: {port: 2369"), 0, "    time_offset_ns: 35ms\n");
+  EXPECT_NE(errorOf(words).find("'time_offset_ns' must be an integer (nanoseconds) or 'estimate'"), std::string::npos);
+  std::string far = kMinimal;
+  far.replace(far.find("    source: {port: 2369"), 0, "    time_offset_ns: 3600000000000\n");
+  EXPECT_NE(errorOf(far).find("'time_offset_ns' = "), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rigcal::config

@@ -167,9 +167,16 @@ TEST_F(Replayed, ReadsTheDriversSharedMemoryRings) {
 
   const TimeNs first = recorded_.scans.front().stamp_ns;
   const auto start = std::chrono::steady_clock::now();
+  // Every 4th front_left scan says its driver lost 3 packets: the consumer counts them per sensor.
+  std::uint64_t injected_loss = 0, front_left_count = 0;
   for (const Scan& s : recorded_.scans) {
     std::this_thread::sleep_until(start + std::chrono::nanoseconds(s.stamp_ns - first));
-    if (writers[s.sensor_id]->publish(s)) ++published[s.sensor_id];
+    Scan sent = s;
+    if (s.sensor_id == "front_left" && front_left_count++ % 4 == 0) sent.missing_packets = 3;
+    if (writers[s.sensor_id]->publish(sent)) {
+      ++published[s.sensor_id];
+      injected_loss += sent.missing_packets;
+    }
   }
   for (auto& [name, w] : writers) w->close();
   runner.join();  // ends by itself: every writer is gone
@@ -189,6 +196,15 @@ TEST_F(Replayed, ReadsTheDriversSharedMemoryRings) {
   EXPECT_EQ(p.registered + p.skipped + dropped >= p.mapping_scans, true)
       << p.registered << " + " << p.skipped << " + " << dropped;
   EXPECT_LE(p.skipped, 1u);
+  // Packet loss the drivers saw reaches the consumer's progress line, per sensor.
+  EXPECT_EQ(p.mapping_lost_packets, 0u);
+  EXPECT_GT(p.lidars.at(0).lost_packets, 0u);
+  EXPECT_LE(p.lidars.at(0).lost_packets, injected_loss);
+  if (st.input_dropped_scans == 0) {
+    EXPECT_EQ(p.lidars.at(0).lost_packets, injected_loss);
+  }
+  EXPECT_NE(p.line().find(" (lost " + std::to_string(p.lidars.at(0).lost_packets) + " pkts)"), std::string::npos)
+      << p.line();
 }
 
 

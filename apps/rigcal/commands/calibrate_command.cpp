@@ -26,17 +26,19 @@
 #include "rigcal/calib/base_lidar/base_from_motion.hpp"
 #include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
 #include "rigcal/calib/base_lidar/base_lidar_multi.hpp"
-#include "rigcal/calib/outputs/calibration_outcome.hpp"
-#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
-#include "rigcal/calib/outputs/cloud_writers.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_worker.hpp"
+#include "rigcal/calib/outputs/calibration_outcome.hpp"
+#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
+#include "rigcal/calib/outputs/cloud_writers.hpp"
 #include "rigcal/calib/outputs/overview_png_writer.hpp"
 #include "rigcal/calib/outputs/report_json_writer.hpp"
 #include "rigcal/calib/outputs/summary_table.hpp"
+#include "../time_offsets.hpp"
 #include "rigcal/config/config_error.hpp"
 #include "rigcal/config/rig_config.hpp"
+#include "rigcal/pipeline/clock_offset_estimate.hpp"
 #include "rigcal/pipeline/pipeline.hpp"
 
 namespace rigcal::app {
@@ -72,6 +74,14 @@ void run(const CalibrateOptions& o) {
   applyExtrinsicsFromBag(rig, po);
   const bool realtime = po.mode == pipeline::PipelineMode::kRealtime;
   prepareOutputFolder(o.out);
+  std::vector<std::string> time_offset_lines;
+  try {
+    time_offset_lines = applyTimeOffsets(
+        rig, po.input == pipeline::InputKind::kPcap ? std::optional<std::filesystem::path>(po.pcap) : std::nullopt);
+  } catch (const std::exception& e) {
+    throw CommandFailed(kExitInput, e.what());
+  }
+  for (const auto& line : time_offset_lines) std::cerr << line << "\n";
 
   StopSignals signals;
   // Every calibration lidar shares one calibration_deadline_s, whenever its dataset comes (budget full
@@ -181,31 +191,56 @@ void run(const CalibrateOptions& o) {
 
   // What the capture or the network cost each sensor, and each sensor's clock against the capture time.
   const auto inputs = pipe->inputs();
-  std::optional<double> mapping_lag_ms;
+  const pipeline::SensorInput* mapping_lag = nullptr;
   for (const auto& in : inputs) {
     outcome.input_summary.emplace_back(in.sensor + "_packets_lost", std::to_string(in.lost_packets));
     outcome.input_summary.emplace_back(in.sensor + "_packets_malformed", std::to_string(in.malformed));
     outcome.input_summary.emplace_back(in.sensor + "_packets_late_dropped", std::to_string(in.late_dropped));
+    outcome.input_summary.emplace_back(in.sensor + "_packets_reordered", std::to_string(in.reordered));
+    outcome.input_summary.emplace_back(in.sensor + "_packets_foreign", std::to_string(in.foreign_packets));
     if (in.clock_lag_ms) {
       std::ostringstream lag;
       lag << std::fixed << std::setprecision(1) << *in.clock_lag_ms;
       outcome.input_summary.emplace_back(in.sensor + "_clock_lag_ms", lag.str());
-      if (in.sensor == rig.roles.mapping_lidar) mapping_lag_ms = in.clock_lag_ms;
+      if (in.sensor == rig.roles.mapping_lidar) mapping_lag = &in;
     }
     if (in.damaged()) {
       std::ostringstream w;
       w << in.sensor << ": " << in.lost_packets << " of " << (in.packets + in.lost_packets) << " packets lost, "
-        << in.malformed << " malformed, " << in.late_dropped << " too late";
+        << in.malformed << " malformed, " << in.late_dropped << " too late, " << in.reordered
+        << " out of order";
       if (!in.last_error.empty()) w << " (last malformed: " << in.last_error << ")";
       if (!in.warning.empty()) w << "; damaged capture: " << in.warning;
+      if (in.foreign_packets > 0) w << "; " << in.foreign;
       outcome.warnings.push_back(w.str());
       std::cerr << "warning: " << w.str() << "\n";
     }
   }
-  for (auto& r : outcome.lidars)
+  if (inputs.empty()) {
+    // Scans from shared-memory rings: their drivers run elsewhere, but each scan says how many packets it
+    // lost, so the damage is still reported per sensor.
+    std::vector<std::pair<std::string, std::uint64_t>> lost{{progress_now.mapping_sensor, progress_now.mapping_lost_packets}};
+    for (const auto& l : progress_now.lidars) lost.emplace_back(l.sensor, l.lost_packets);
+    for (const auto& [sensor, n] : lost) {
+      outcome.input_summary.emplace_back(sensor + "_packets_lost", std::to_string(n));
+      if (n == 0) continue;
+      outcome.warnings.push_back(sensor + ": " + std::to_string(n) + " packets lost (as its scans from the ring say)");
+      std::cerr << "warning: " << outcome.warnings.back() << "\n";
+    }
+  }
+  for (const auto& s : rig.sensors)
+    if (s.time_offset_ns != 0 || s.estimate_time_offset)
+      outcome.input_summary.emplace_back(s.name + "_time_offset_ns", std::to_string(s.time_offset_ns));
+  for (auto& r : outcome.lidars) {
+    r.evidence.time_offset_applied_ms = double(rig.sensor(r.calibration_sensor).time_offset_ns) * 1e-6;
     for (const auto& in : inputs)
-      if (in.sensor == r.calibration_sensor && in.clock_lag_ms && mapping_lag_ms)
-        calib::doubtClockOffset(r, *mapping_lag_ms - *in.clock_lag_ms, kClockOffsetLimitMs);
+      if (in.sensor == r.calibration_sensor && in.clock_lag_ms && mapping_lag != nullptr) {
+        const auto offset = pipeline::clockOffsetBetween(
+            {*mapping_lag->clock_lag_ms, mapping_lag->clock_lag_sigma_ms, mapping_lag->clock_lag_sweeps},
+            {*in.clock_lag_ms, in.clock_lag_sigma_ms, in.clock_lag_sweeps});
+        calib::doubtClockOffset(r, offset.offset_ms, kClockOffsetLimitMs, offset.uncertainty_ms);
+      }
+  }
   const auto shortfalls = pipe->shortfalls();
   for (const auto& sf : shortfalls) outcome.input_summary.emplace_back(sf.sensor + "_missing", sf.message);
   const std::filesystem::path out(o.out);

@@ -118,6 +118,9 @@ void run(const DriverOptions& o) {
             << " too large for a slot; " << a.packets << " packets, " << a.malformed << " malformed, "
             << a.lost_packets << " lost" << std::endl;
   if (!driver->warning().empty()) std::cerr << "warning: " << driver->warning() << '\n';
+  if (driver->foreignPackets().packets > 0)
+    std::cerr << "warning: sensor '" << sensor.name << "': "
+              << driver->foreignPackets().describe(sensor.model, sensor.source.port) << '\n';
   if (const auto& s = driver->sourceStats(); o.live && s.filtered > 0)
     std::cerr << "warning: " << s.filtered << " datagrams on port " << sensor.source.port
               << " dropped by the source-address filter (sensor address " << sensor.source.address.value_or("?")

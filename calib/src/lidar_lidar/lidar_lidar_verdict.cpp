@@ -103,15 +103,21 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
   r.doubt = why.str();
 }
 
-void doubtClockOffset(LidarLidarResult& r, double offset_ms, double limit_ms) {
+void doubtClockOffset(LidarLidarResult& r, double offset_ms, double limit_ms, double uncertainty_ms) {
   r.evidence.clock_offset_ms = offset_ms;
+  r.evidence.clock_offset_uncertainty_ms = uncertainty_ms;
+  r.evidence.clock_measured = true;
   if (std::abs(offset_ms) <= limit_ms || r.verdict == Verdict::kFailed) return;
   std::ostringstream why;
   why.setf(std::ios::fixed);
   why.precision(1);
+  // The correction adds to what the rig already subtracts.
+  const double total_ms = r.evidence.time_offset_applied_ms + offset_ms;
   why << "clock: " << r.calibration_sensor << "'s packet clock is " << std::showpos << offset_ms << std::noshowpos
-      << " ms off " << r.mapping_sensor << "'s (each against the capture time; more than " << limit_ms
-      << " ms pairs it with the wrong mapping pose): fix the sensor's time sync";
+      << " ms off " << r.mapping_sensor << "'s (± " << uncertainty_ms
+      << " ms; each against the capture time; more than " << limit_ms
+      << " ms pairs it with the wrong mapping pose): fix the sensor's time sync, or set its time_offset_ns: "
+      << std::llround(total_ms * 1e6) << " (or estimate) in the rig";
   r.doubt = r.verdict == Verdict::kUnverified ? why.str() + "; " + r.doubt : why.str();
   r.verdict = Verdict::kUnverified;
 }

@@ -82,6 +82,10 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
                    {"registrators_agreeing", e.registrators_agreeing},
                    {"inlier_ratio", e.inlier_ratio},
                    {"clock_offset_ms", e.clock_offset_ms}};
+  if (e.clock_measured) {
+    j["evidence"]["clock_offset_uncertainty_ms"] = e.clock_offset_uncertainty_ms;
+    j["evidence"]["time_offset_applied_ms"] = e.time_offset_applied_ms;
+  }
   if (e.suggested_deadline_s > 0) j["evidence"]["suggested_deadline_s"] = e.suggested_deadline_s;
   j["deadline_reached"] = r->deadline_reached;  // this lidar ran out of time (its result is the best so far)
   if (r->deadline_share_s >= 0) j["deadline_share_s"] = r->deadline_share_s;

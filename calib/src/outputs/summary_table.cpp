@@ -63,6 +63,20 @@ std::string summaryTable(const CalibrationOutcome& o) {
       out << line;
     }
   }
+  for (const auto& r : o.lidars) {
+    // The residual clock offset each result was judged with (after any time_offset_ns the rig applied).
+    const LidarLidarEvidence& e = r.evidence;
+    if (!e.clock_measured) continue;
+    char line[256];
+    std::snprintf(line, sizeof line, "  %s: clock %+.1f ms (± %.2f) against %s", r.calibration_sensor.c_str(),
+                  e.clock_offset_ms, e.clock_offset_uncertainty_ms, r.mapping_sensor.c_str());
+    out << line;
+    if (e.time_offset_applied_ms != 0.0) {
+      std::snprintf(line, sizeof line, " after its time_offset_ns (%+.1f ms)", e.time_offset_applied_ms);
+      out << line;
+    }
+    out << "\n";
+  }
   for (const auto& w : o.warnings) out << "  warning: " << w << "\n";
   if (o.base && !o.base->ok) out << "  " << o.mapping_sensor << " (base): " << o.base->failure << "\n";
   if (o.base && o.base->ok) {

@@ -47,6 +47,11 @@ struct SensorConfig {
   std::filesystem::path metadata;     // absolute, or empty
   TimeSource time_source = TimeSource::kSensorClock;
   double cut_angle_deg = 0.0;
+  /// How far this sensor's clock runs ahead of the rig's (the mapping lidar's): its scan stamps are
+  /// corrected by subtracting it. `time_offset_ns: estimate` measures it before a pcap run
+  /// (estimate_time_offset; see pipeline/clock_offset_estimate.hpp).
+  TimeNs time_offset_ns = 0;
+  bool estimate_time_offset = false;
   SourceLocation where;               // the sensor's entry, for later error messages
 };
 

@@ -68,6 +68,7 @@ struct LidarProgress {
   std::uint64_t selected = 0;    // frames the selector holds now
   int budget = 0;                // lidar_calibration_max_frames
   bool handed_over = false;      // its dataset went to the callback
+  std::uint64_t lost_packets = 0;  // the packets its scans say were lost (any input: pcap, live, rings)
 };
 
 struct PipelineProgress {
@@ -79,6 +80,8 @@ struct PipelineProgress {
   std::uint64_t stopped_frames = 0;
   std::uint64_t lost_frames = 0;
   bool mapping_done = false;  // mapping_max_frames reached: the mapper stopped by itself
+  std::string mapping_sensor;
+  std::uint64_t mapping_lost_packets = 0;  // as LidarProgress::lost_packets, for the mapping lidar
   std::vector<LidarProgress> lidars;
   /// Mean budget fill over the calibration lidars, 0..1.
   [[nodiscard]] double budgetFill() const;
@@ -140,11 +143,18 @@ struct SensorInput {
   std::uint64_t lost_packets = 0;       // gaps in the sensor's packet sequence
   std::uint64_t malformed = 0;          // packets and frames dropped as malformed (decoder and source)
   std::uint64_t late_dropped = 0;       // packets older than one already assembled
+  std::uint64_t reordered = 0;          // packets that came after a later one (put back in order unless late)
+  std::uint64_t foreign_packets = 0;    // packets of another model on its port, ignored
+  std::string foreign;                  // ForeignPackets::describe(), when foreign_packets > 0
   std::uint64_t fragments_dropped = 0;  // IPv4 fragments never completed (of every sensor in the capture)
   std::string last_error;               // the latest malformed packet's reason
   std::string warning;                  // the capture ended abnormally (e.g. truncated mid-record)
   std::optional<double> clock_lag_ms;   // SensorDriver::clockLagMs()
-  [[nodiscard]] bool damaged() const { return lost_packets + malformed + late_dropped > 0 || !warning.empty(); }
+  double clock_lag_sigma_ms = 0.0;      // the standard error of clock_lag_ms (ClockLag::sigma_ms)
+  std::size_t clock_lag_sweeps = 0;
+  [[nodiscard]] bool damaged() const {
+    return lost_packets + malformed + late_dropped + foreign_packets > 0 || !warning.empty();
+  }
 };
 
 class Pipeline {

@@ -13,6 +13,7 @@
 #include "rigcal/bag/bag_cloud_source.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/drivers/packet_decoder.hpp"
+#include "rigcal/drivers/packet_family.hpp"
 #include "rigcal/drivers/packet_source.hpp"
 #include "rigcal/drivers/scan_assembler.hpp"
 
@@ -36,6 +37,16 @@ struct DriverInput {
 inline constexpr const char* kPointCloud2Model = "PointCloud2";
 /// Points per scan a PointCloud2 sensor's ring slot holds: an OS-128 at 2048 columns, dual return.
 inline constexpr std::size_t kMaxPointCloud2Points = std::size_t(1) << 19;
+
+/// Packets of another vendor's model that reached a sensor's port or filter (drivers::recognizePacket).
+struct ForeignPackets {
+  std::uint64_t packets = 0;
+  drivers::PacketFamily family = drivers::PacketFamily::kUnknown;  // of the last one
+  std::size_t bytes = 0;                                           // its size
+  drivers::UdpEndpoint last_source;
+  /// One line: how many, what they look like, from where (for the sensor `model` on `port`).
+  [[nodiscard]] std::string describe(const std::string& model, std::uint16_t port) const;
+};
 
 /// The decoder settings of a rig sensor.
 drivers::DecoderConfig decoderConfigFor(const config::SensorConfig& sensor);
@@ -63,6 +74,10 @@ class SensorDriver {
   /// time of the sweep's last point), in ms; nullopt before the first sweep. Sensors whose clocks agree
   /// show the same lag within the network's and the assembler's few ms (see SensorClockCheck).
   [[nodiscard]] std::optional<double> clockLagMs() const;
+  /// Packets of another model held back from the decoder (complete once run() returned).
+  [[nodiscard]] const ForeignPackets& foreignPackets() const;
+  /// The per-sweep lags behind clockLagMs() (their spread gives its uncertainty).
+  [[nodiscard]] std::vector<double> clockLagSamplesMs() const;
 
  private:
   config::SensorConfig sensor_;

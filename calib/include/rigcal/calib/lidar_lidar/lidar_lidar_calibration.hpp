@@ -59,6 +59,9 @@ struct LidarLidarEvidence {
   double inlier_ratio = 0.0;         // of the final score
   double suggested_deadline_s = 0.0; // > 0: the calibration_deadline_s (--deadline) that would confirm it
   double clock_offset_ms = 0.0;      // its packet clock against the mapping lidar's (both vs capture time)
+  double clock_offset_uncertainty_ms = 0.0;  // one standard error of clock_offset_ms
+  bool clock_measured = false;       // both clocks were measured (else clock_offset_ms says nothing)
+  double time_offset_applied_ms = 0.0;  // the rig's time_offset_ns (given or estimated) already subtracted
 };
 
 struct LidarLidarResult {

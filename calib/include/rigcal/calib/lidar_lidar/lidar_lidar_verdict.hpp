@@ -27,7 +27,8 @@ void judgeLidarLidar(LidarLidarResult& result, std::size_t frames_selected, doub
 
 /// A lidar whose packet clock is `offset_ms` off the mapping lidar's (each against the capture / receive
 /// time) is paired with the wrong mapping pose: 50 ms at walking speed put a lidar 7 cm off with a normal
-/// score. Records the offset; above `limit_ms` a result is not called ok (the sensor and the offset named).
-void doubtClockOffset(LidarLidarResult& result, double offset_ms, double limit_ms);
+/// score. Records the offset (± `uncertainty_ms`, one standard error); above `limit_ms` a result is not called
+/// ok (the sensor and the offset named, with the rig's time_offset_ns that would correct it).
+void doubtClockOffset(LidarLidarResult& result, double offset_ms, double limit_ms, double uncertainty_ms = 0.0);
 
 }  // namespace rigcal::calib
