@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "rigcal/pipeline/calibration_crop.hpp"
 #include "rigcal/pipeline/frame_selector.hpp"
 
 namespace rigcal::pipeline {
@@ -83,17 +84,7 @@ PairingLane::Step PairingLane::pairNext(const MappingView& view, std::vector<Can
   if (c.pairing.accepted) {
     // Crop z in the mapping-lidar frame (through the initial extrinsic) and apply the range limits.
     auto cropped = std::make_shared<Scan>(*scan.deskewed);
-    const double min2 = params_.min_calibration_range * params_.min_calibration_range;
-    const double max2 = params_.max_calibration_range * params_.max_calibration_range;
-    const Eigen::Matrix3d R = T_mapping_calib_.linear();
-    const Eigen::Vector3d t = T_mapping_calib_.translation();
-    cropped->filter([&](std::size_t i) {
-      const Eigen::Vector3d p(cropped->x[i], cropped->y[i], cropped->z[i]);
-      const double r2 = p.squaredNorm();
-      if (!(r2 >= min2 && r2 < max2)) return false;
-      return !params_.crop_z_calibration_pointclouds ||
-             (R.row(2).dot(p) + t.z()) <= params_.crop_z_calibration_pointclouds_value;
-    });
+    cropCalibrationCloud(*cropped, T_mapping_calib_, params_);
     if (int(cropped->size()) < params_.min_calibration_pointcloud_size) {
       c.pairing.accepted = false;
       c.pairing.rejection = std::to_string(cropped->size()) + " points after cropping < min_calibration_pointcloud_size " +

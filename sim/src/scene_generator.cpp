@@ -30,7 +30,7 @@ bool Placer::free(const Rect2& r, double margin) const {
 
 }  // namespace detail
 
-std::vector<std::string> sceneLayouts() { return {"parking-lot", "street", "empty"}; }
+std::vector<std::string> sceneLayouts() { return {"parking-lot", "street", "container-yard", "empty"}; }
 
 Ground makeGround(const SceneSpec& spec, std::uint64_t seed) {
   Rng rng(hashKeys(seed, 0x67726f756e64ULL));  // "ground"
@@ -54,8 +54,10 @@ SceneContent generateScene(const SceneSpec& spec, std::uint64_t seed, Ground gro
     detail::layoutParkingLot(spec, build, place, rng);
   else if (spec.layout == "street")
     detail::layoutStreet(spec, build, place, rng);
+  else if (spec.layout == "container-yard")
+    detail::layoutContainerYard(spec, build, content, place, rng);
   else if (spec.layout != "empty")
-    throw std::invalid_argument("unknown scene layout '" + spec.layout + "'; known: parking-lot, street, empty");
+    throw std::invalid_argument("unknown scene layout '" + spec.layout + "'; known: parking-lot, street, container-yard, empty");
   return content;
 }
 

@@ -25,5 +25,7 @@ class Placer {
 
 void layoutParkingLot(const SceneSpec& spec, ObjectBuilder& build, Placer& place, Rng& rng);
 void layoutStreet(const SceneSpec& spec, ObjectBuilder& build, Placer& place, Rng& rng);
+void layoutContainerYard(const SceneSpec& spec, ObjectBuilder& build, SceneContent& content, Placer& place,
+                         Rng& rng);
 
 }  // namespace rigcal::sim::detail

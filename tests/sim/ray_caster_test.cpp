@@ -180,6 +180,27 @@ TEST(SceneGenerator, LayoutsHoldEveryKindOfObject) {
   }
 }
 
+// The container yard (issue 19's unusual-mount presets): stacks up to four containers high, stepped ramps
+// rising to docks, and a sloped ground, so a tilted or sideways lidar sees walls above and below itself.
+TEST(SceneGenerator, ContainerYardHasStacksRampsAndSlope) {
+  const Simulation sim(loadScenario("yard-corners"));
+  const SceneContent& c = sim.scene().content();
+  const Ground& g = c.ground;
+  int containers = 0, high_tiers = 0, ramp_steps = 0;
+  for (const auto& b : c.boxes) {
+    const double ground = g.height(b.cx, b.cy);
+    if (b.material == Material::kMetal && b.z1 - b.z0 > 2.5) {
+      ++containers;
+      if (b.z0 - ground > 5.0) ++high_tiers;  // third tier or above
+    }
+    if (b.material == Material::kConcrete && b.hx == 0.25 && b.z1 - ground > 0.3) ++ramp_steps;
+  }
+  EXPECT_GT(containers, 60);
+  EXPECT_GT(high_tiers, 5) << "stacks three or four high";
+  EXPECT_GT(ramp_steps, 16) << "at least two ramps";
+  EXPECT_GT(g.spec().slope.norm(), 0.025) << "3 % slope";
+}
+
 TEST(SceneGenerator, NothingStandsOnThePath) {
   const Simulation sim(loadScenario("parking-lot"));
   const double clearance = sim.scenario().scene.clearance_m;

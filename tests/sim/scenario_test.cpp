@@ -19,7 +19,7 @@ std::vector<std::string> modelsOf(const Scenario& s) {
 }
 
 TEST(Scenario, PresetsDescribeTheRequestedRigs) {
-  EXPECT_EQ(builtinScenarioNames(), (std::vector<std::string>{"base-motion", "lost", "parking-lot", "pose", "street"}));
+  EXPECT_EQ(builtinScenarioNames(), (std::vector<std::string>{"base-motion", "lost", "parking-lot", "pose", "street", "yard-corners", "yard-side"}));
   const Scenario p = loadScenario("parking-lot");
   EXPECT_EQ(modelsOf(p), (std::vector<std::string>{"OS1-64", "VLP-16", "VLP-16"}));
   EXPECT_EQ(p.calibration_lidars.size(), 2u);
@@ -32,8 +32,21 @@ TEST(Scenario, PresetsDescribeTheRequestedRigs) {
   EXPECT_EQ(q.sensors.size(), 1u);
   EXPECT_EQ(q.sensors[0].clock_offset_ns - q.pose_sensor->clock_offset_ns, 15 * kNsPerMs);
   EXPECT_TRUE(q.trajectory.excitation.active());
+  // Issue 19's unusual mounts: a 32-beam Velodyne maps; 16-beam corner lidars yawed ±45° and pitched down,
+  // a rear one yawed 180°; side lidars with their spin axis horizontal, in a container yard.
+  const Scenario yc = loadScenario("yard-corners");
+  EXPECT_EQ(modelsOf(yc), (std::vector<std::string>{"VLP-32C", "VLP-16", "VLP-16", "VLP-16"}));
+  EXPECT_EQ(yc.scene.layout, "container-yard");
+  const Eigen::Vector3d rear_forward = yc.sensors[3].T_base_sensor.linear() * Eigen::Vector3d::UnitX();
+  EXPECT_LT(rear_forward.x(), -0.9);  // looks backwards
+  EXPECT_LT(rear_forward.z(), -0.15);  // and down (10-25°)
+  const Scenario ys = loadScenario("yard-side");
+  for (std::size_t i = 1; i < ys.sensors.size(); ++i) {
+    const Eigen::Vector3d spin_axis = ys.sensors[i].T_base_sensor.linear() * Eigen::Vector3d::UnitZ();
+    EXPECT_LT(std::abs(spin_axis.z()), 1e-6) << ys.sensors[i].name << ": spin axis horizontal";
+  }
   // Sensors are not synchronised: distinct scan phases within each rig.
-  for (const Scenario* sc : {&p, &s}) {
+  for (const Scenario* sc : {&p, &s, &yc, &ys}) {
     std::set<double> phases;
     for (const auto& x : sc->sensors) phases.insert(x.scan_phase_deg);
     EXPECT_EQ(phases.size(), sc->sensors.size()) << sc->name;
