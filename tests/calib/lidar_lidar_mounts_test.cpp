@@ -40,8 +40,8 @@ const test::SimDatasets& yardDatasets(const std::string& scenario) {
   if (!d) {
     test::SimDatasetOptions o;
     o.scenario = scenario;
-    o.seconds = test::kSanitized ? 6.0 : 10.0;
-    o.frames = test::kSanitized ? 2 : 3;
+    o.seconds = 10.0;
+    o.frames = 3;
     auto data = test::buildSimDatasets(o);
     // The pairing lane's crop, as `rigcal calibrate` applies it before frame selection (the simulator's
     // datasets skip the pipeline).
@@ -99,6 +99,9 @@ class LidarLidarMounts : public ::testing::TestWithParam<const char*> {};
 //                 that the roof lidar's blind circle hides on a straight drive. Not solved: the side rig is held
 //                 to an honest verdict (never ok when off the goal), the corners to the goal.
 TEST_P(LidarLidarMounts, EveryCalibrationLidarWithinTheGoalFromAThirtyCentimetreFiveDegreeGuess) {
+  // Whole calibrations without a deadline: minutes under the sanitizers, which see the same code paths in
+  // rigcal_lidar_lidar_tests.
+  if (test::kSanitized) GTEST_SKIP() << "accuracy of unbounded calibrations: Release only";
   const bool side = std::string(GetParam()) == "yard-side";
   const auto& data = yardDatasets(GetParam());
   ASSERT_GE(data.datasets.size(), 2u);
@@ -107,7 +110,6 @@ TEST_P(LidarLidarMounts, EveryCalibrationLidarWithinTheGoalFromAThirtyCentimetre
   for (const auto& d : data.datasets) {
     const Row row =
         calibrateOne(data, d, data.params, registration::Deadline::after(std::chrono::seconds(900)), 900, quick);
-    if (test::kSanitized) continue;  // a shorter drive with two frames: behaviour only
     const bool within = row.dt_cm < 1.0 && row.dr_deg < 0.05;
     if (row.verdict == Verdict::kOk) {
       EXPECT_TRUE(within) << row.sensor << " is called ok off the goal";
