@@ -197,5 +197,23 @@ TEST_F(SimBag, RigFromBagNamesEverySensorModelTopicAndExtrinsic) {
   }
 }
 
+// rig-from-bag on the PointCloud2 form: `model: PointCloud2` sensors on the points topics, a rig that
+// check-config accepts as written (no decoder, calibration or metadata file to add).
+TEST_F(SimBag, RigFromAPointCloud2BagRunsAsWritten) {
+  ASSERT_EQ(sim_->exit_code, 0) << sim_->err;
+  const fs::path sim = dir_->path() / "sim", rig = dir_->path() / "from_points.yaml";
+  const auto r = runRigcal({"rig-from-bag", (sim / "recording_points.mcap").string(), "--out", rig.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const YAML::Node got = YAML::LoadFile(rig.string());
+  ASSERT_EQ(got["sensors"].size(), std::size(kSensors));
+  for (std::size_t i = 0; i < std::size(kSensors); ++i) {
+    const YAML::Node s = got["sensors"][i];
+    EXPECT_EQ(s["model"].as<std::string>(), "PointCloud2") << s["name"];
+    EXPECT_EQ(s["source"]["topic"].as<std::string>(), "/" + s["name"].as<std::string>() + "/points");
+  }
+  const auto checked = runRigcal({"check-config", rig.string()});
+  EXPECT_EQ(checked.exit_code, 0) << checked.out << checked.err;
+}
+
 }  // namespace
 }  // namespace rigcal::test

@@ -91,8 +91,15 @@ std::string starterRig(const BagSummary& summary) {
   y << "sensors:\n";
   for (const auto& l : lidars) {
     y << "  - name: " << l.name << "\n";
-    y << "    model: " << (l.topic->model.model.empty() ? "UNKNOWN" : l.topic->model.model) << "  # check: "
-      << (l.topic->model.note.empty() ? "no guess" : l.topic->model.note) << "\n";
+    if (l.topic->info.type == "sensor_msgs/msg/PointCloud2") {
+      // Clouds are read as they are (no decoder, calibration or metadata): the rig runs without edits.
+      y << "    model: PointCloud2  # the clouds as recorded; the sensor: "
+        << (l.topic->model.model.empty() ? "unknown" : l.topic->model.model) << " ("
+        << (l.topic->model.note.empty() ? "no guess" : l.topic->model.note) << ")\n";
+    } else {
+      y << "    model: " << (l.topic->model.model.empty() ? "UNKNOWN" : l.topic->model.model) << "  # check: "
+        << (l.topic->model.note.empty() ? "no guess" : l.topic->model.note) << "\n";
+    }
     y << "    source: {topic: " << l.topic->info.name << "}  # " << l.topic->info.type << ", " << l.topic->count
       << " messages";
     if (l.topic->cloud_points) y << ", " << l.topic->cloud_points << " points in the first";
