@@ -30,7 +30,7 @@ bool Placer::free(const Rect2& r, double margin) const {
 
 }  // namespace detail
 
-std::vector<std::string> sceneLayouts() { return {"parking-lot", "street", "empty"}; }
+std::vector<std::string> sceneLayouts() { return {"parking-lot", "street", "empty", "calibration-bay", "bay-one-wall"}; }
 
 Ground makeGround(const SceneSpec& spec, std::uint64_t seed) {
   Rng rng(hashKeys(seed, 0x67726f756e64ULL));  // "ground"
@@ -54,8 +54,12 @@ SceneContent generateScene(const SceneSpec& spec, std::uint64_t seed, Ground gro
     detail::layoutParkingLot(spec, build, place, rng);
   else if (spec.layout == "street")
     detail::layoutStreet(spec, build, place, rng);
+  else if (spec.layout == "calibration-bay")
+    detail::layoutCalibrationBay(spec, build, place, rng, content);
+  else if (spec.layout == "bay-one-wall")
+    detail::layoutBayOneWall(spec, build, place, rng, content);
   else if (spec.layout != "empty")
-    throw std::invalid_argument("unknown scene layout '" + spec.layout + "'; known: parking-lot, street, empty");
+    throw std::invalid_argument("unknown scene layout '" + spec.layout + "'; known: parking-lot, street, empty, calibration-bay, bay-one-wall");
   return content;
 }
 
