@@ -68,16 +68,16 @@ void layoutCalibrationBay(const SceneSpec& spec, ObjectBuilder& build, Placer& p
       place.occupy(fp);
     }
   // Targets on a ring around the vehicle, each turned a different way and at its own height.
-  const int targets = 8;
+  const int targets = 12;
   const double turn0 = rng.uniform(0, 2 * M_PI);
   for (int k = 0; k < targets; ++k) {
-    const double a = turn0 + 2 * M_PI * k / targets, r = rng.uniform(4.0, 5.5);
+    const double a = turn0 + 2 * M_PI * k / targets, r = rng.uniform(3.5, 5.0);
     const Eigen::Vector2d at = spec.center + r * Eigen::Vector2d(std::cos(a), std::sin(a));
     const double facing = a + M_PI + rng.uniform(-0.7, 0.7);  // roughly towards the vehicle
     target(at, facing, rng.uniform(0.3, 1.4), build, place, content);
   }
   // Crate stacks between the targets and the walls.
-  for (int k = 0; k < 14; ++k) {
+  for (int k = 0; k < 24; ++k) {
     const double px = rng.uniform(lo.x() + 1.5, hi.x() - 1.5), py = rng.uniform(lo.y() + 1.5, hi.y() - 1.5);
     const Eigen::Vector2d at(px, py);
     if ((at - spec.center).norm() < spec.clearance_m + 1.5) continue;
