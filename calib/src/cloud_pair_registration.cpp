@@ -168,9 +168,7 @@ CloudPairResult registerCloudPair(const Scan& target_scan, const Scan& source_sc
     p.coarse_to_fine = false;
     p.check_degeneracy = false;  // reported below instead (information per direction)
     p.num_threads = opt.num_threads;
-    // Under one shared deadline (static calibration) the polish keeps to it too; `register` always polishes.
-    const auto polished = registration::alignIcp(target, source, r.T_target_source, p,
-                                                 opt.deadline_covers_global ? deadline : registration::Deadline{});
+    const auto polished = registration::alignIcp(target, source, r.T_target_source, p);
     if (polished.T_target_source.matrix().allFinite()) {
       const auto s = scoreFrame(target, source, polished.T_target_source, d_eval, opt.num_threads);
       if (s.betterThan(final_score)) {
