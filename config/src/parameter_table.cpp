@@ -74,6 +74,9 @@ const std::vector<ParameterSpec>& parameterSpecs() {
       {"base_lidar_max_cos_distance", &P::base_lidar_max_cos_distance, 0, 1, {}},
       {"base_lidar_overwrite_xy_yaw", &P::base_lidar_overwrite_xy_yaw, 0, 0, {}},
       {"base_link_from_motion", &P::base_link_from_motion, 0, 0, {"off", "yaw", "yaw_x"}},
+      {"static_capture_s", &P::static_capture_s, 0.1, 600, {}},
+      {"static_max_motion_m", &P::static_max_motion_m, 1e-4, 10, {}},
+      {"static_max_motion_deg", &P::static_max_motion_deg, 1e-3, 180, {}},
   };
   return specs;
 }

@@ -282,7 +282,7 @@ Scenario parseScenario(const std::string& text, const std::string& origin) {
     ss.layout = r.text(scene["layout"], "layout");
     const auto layouts = sceneLayouts();
     if (std::find(layouts.begin(), layouts.end(), ss.layout) == layouts.end())
-      r.fail(scene["layout"], "unknown layout '" + ss.layout + "' (parking-lot, street, container-yard, empty)");
+      r.fail(scene["layout"], "unknown layout '" + ss.layout + "' (parking-lot, street, container-yard, empty, calibration-bay, bay-one-wall)");
   }
   if (scene["center"]) ss.center = r.vec2(scene["center"], "center");
   if (scene["size"]) ss.size = r.vec2(scene["size"], "size");

@@ -30,7 +30,9 @@ bool Placer::free(const Rect2& r, double margin) const {
 
 }  // namespace detail
 
-std::vector<std::string> sceneLayouts() { return {"parking-lot", "street", "container-yard", "empty"}; }
+std::vector<std::string> sceneLayouts() {
+  return {"parking-lot", "street", "container-yard", "empty", "calibration-bay", "bay-one-wall"};
+}
 
 Ground makeGround(const SceneSpec& spec, std::uint64_t seed) {
   Rng rng(hashKeys(seed, 0x67726f756e64ULL));  // "ground"
@@ -56,8 +58,13 @@ SceneContent generateScene(const SceneSpec& spec, std::uint64_t seed, Ground gro
     detail::layoutStreet(spec, build, place, rng);
   else if (spec.layout == "container-yard")
     detail::layoutContainerYard(spec, build, content, place, rng);
+  else if (spec.layout == "calibration-bay")
+    detail::layoutCalibrationBay(spec, build, place, rng, content);
+  else if (spec.layout == "bay-one-wall")
+    detail::layoutBayOneWall(spec, build, place, rng, content);
   else if (spec.layout != "empty")
-    throw std::invalid_argument("unknown scene layout '" + spec.layout + "'; known: parking-lot, street, container-yard, empty");
+    throw std::invalid_argument("unknown scene layout '" + spec.layout +
+                                "'; known: parking-lot, street, container-yard, empty, calibration-bay, bay-one-wall");
   return content;
 }
 

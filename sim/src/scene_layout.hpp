@@ -27,5 +27,8 @@ void layoutParkingLot(const SceneSpec& spec, ObjectBuilder& build, Placer& place
 void layoutStreet(const SceneSpec& spec, ObjectBuilder& build, Placer& place, Rng& rng);
 void layoutContainerYard(const SceneSpec& spec, ObjectBuilder& build, SceneContent& content, Placer& place,
                          Rng& rng);
+// scene_layout_bay.cpp: a parked vehicle's calibration bays (they add primitives straight to `content`).
+void layoutCalibrationBay(const SceneSpec& spec, ObjectBuilder& build, Placer& place, Rng& rng, SceneContent& content);
+void layoutBayOneWall(const SceneSpec& spec, ObjectBuilder& build, Placer& place, Rng& rng, SceneContent& content);
 
 }  // namespace rigcal::sim::detail

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -19,7 +20,13 @@ std::vector<std::string> modelsOf(const Scenario& s) {
 }
 
 TEST(Scenario, PresetsDescribeTheRequestedRigs) {
-  EXPECT_EQ(builtinScenarioNames(), (std::vector<std::string>{"base-motion", "lost", "parking-lot", "pose", "street", "yard-corners", "yard-side"}));
+  const auto names = builtinScenarioNames();
+  for (const char* preset : {"base-motion", "lost", "parking-lot", "pose", "street", "calibration-bay", "calibration-bay-degenerate",
+                             "yard-corners", "yard-side"})
+    EXPECT_NE(std::find(names.begin(), names.end(), preset), names.end()) << preset;
+  const Scenario bay = loadScenario("calibration-bay");  // static calibration: parked, tilted side lidars
+  EXPECT_EQ(modelsOf(bay), (std::vector<std::string>{"OS1-64", "VLP-16", "VLP-16"}));
+  EXPECT_EQ(bay.calibration_lidars.size(), 2u);
   const Scenario p = loadScenario("parking-lot");
   EXPECT_EQ(modelsOf(p), (std::vector<std::string>{"OS1-64", "VLP-16", "VLP-16"}));
   EXPECT_EQ(p.calibration_lidars.size(), 2u);

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "../bag_extrinsics.hpp"
+#include "../calibrate_static.hpp"
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
 #include "../rig_loading.hpp"
@@ -50,6 +51,7 @@ struct CalibrateOptions {
   std::string config, out = "rigcal-out";
   PipelineCliOptions pipeline;
   double deadline = -1.0;  // < 0: the rig's calibration_deadline_s
+  bool static_vehicle = false;  // --static: a parked vehicle (calibrate_static_command.cpp)
 };
 
 /// Packet clocks further apart than this (each against the capture time) make a result unverified: at
@@ -292,12 +294,16 @@ void addCalibrateCommand(CLI::App& app) {
   cmd->add_option("--out", o->out, "output folder (default rigcal-out)");
   cmd->add_option("--deadline", o->deadline, "seconds for the lidar-lidar calibration (calibration_deadline_s)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--static", o->static_vehicle,
+                "the vehicle stands still: accumulate static_capture_s of every lidar and register the clouds "
+                "directly (refused when the vehicle moves)");
   cmd->footer(kExitCodesHelp);
   cmd->callback([o, cmd] {
     if (o->pipeline.pcap.empty() && o->pipeline.bag.empty() && !o->pipeline.live && !o->pipeline.shm)
       throw CLI::RequiredError("--pcap or --bag or --live or --shm");
     (void)cmd;
-    run(*o);
+    if (o->static_vehicle) runCalibrateStatic(o->config, o->pipeline, o->out, o->deadline);
+    else run(*o);
   });
 }
 

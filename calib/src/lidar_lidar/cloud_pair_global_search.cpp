@@ -188,7 +188,10 @@ GlobalSearchResult globalSearch(const std::vector<Eigen::Vector3d>& target, cons
   Scorer scorer(grid, src, f);
   std::vector<Candidate> coarse;
   const auto as = steps(0.0, s.translation_range, s.translation_step);
-  for (const double yaw : steps(0.0, deg2rad(s.yaw_range_deg), deg2rad(s.yaw_step_deg))) scorer.scanYaw(yaw, as, as, coarse);
+  std::vector<double> yaws = steps(0.0, deg2rad(s.yaw_range_deg), deg2rad(s.yaw_step_deg));
+  // A full turn would score ±180° twice: the same pose.
+  if (yaws.size() > 1 && yaws.back() - yaws.front() >= 2 * M_PI - 1e-9) yaws.pop_back();
+  for (const double yaw : yaws) scorer.scanYaw(yaw, as, as, coarse);
   std::sort(coarse.begin(), coarse.end(), [](const Candidate& x, const Candidate& y) { return x.score < y.score; });
 
   // 3. The best distinct basins, each refined on a finer grid around it.

@@ -146,8 +146,11 @@ CloudPairResult registerCloudPair(const Scan& target_scan, const Scan& source_sc
   lo.num_threads = opt.num_threads;
   lo.redeskew = false;  // standing still: nothing to deskew
   lo.exhaustive = opt.exhaustive;
+  const double spent = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double ensemble_s =
+      opt.deadline_covers_global ? std::max(0.1 * opt.deadline_s, opt.deadline_s - spent) : opt.deadline_s;
   const auto deadline = registration::Deadline::after(
-      std::chrono::duration_cast<registration::Deadline::Clock::duration>(std::chrono::duration<double>(opt.deadline_s)));
+      std::chrono::duration_cast<registration::Deadline::Clock::duration>(std::chrono::duration<double>(ensemble_s)));
   r.ensemble = calibrateLidarLidar(dataset, params, deadline, lo);
   // The ensemble keeps its start when nothing beats it: the start (the global stage's) is then the result.
   r.T_target_source = r.ensemble.ok ? r.ensemble.T_mapping_calib : start;
@@ -191,6 +194,14 @@ CloudPairResult registerCloudPair(const Scan& target_scan, const Scan& source_sc
     std::ostringstream msg;
     msg << "the clouds do not overlap: " << std::fixed << std::setprecision(1) << 100 * r.source_overlap
         << " % of the source within " << opt.overlap_distance << " m of the target after registration";
+    return finish(msg.str());
+  }
+  if (final_score.inlier_ratio < opt.min_inlier_ratio) {
+    r.not_enough_data = true;
+    std::ostringstream msg;
+    msg << "the clouds do not overlap: after registration only " << std::fixed << std::setprecision(1)
+        << 100 * final_score.inlier_ratio << " % of the source lies within " << std::setprecision(2) << d_eval
+        << " m of the target (a registration needs " << std::setprecision(0) << 100 * opt.min_inlier_ratio << " %)";
     return finish(msg.str());
   }
   if (!final_score.betterThan(r.guess_score) && !r.ensemble.ok && !r.global) {

@@ -82,6 +82,13 @@ struct Parameters {
   // rigcal: base_link yaw ("yaw") or yaw and x ("yaw_x") from the mapping lidar's motion (rear-axle
   // base_link, no side slip); "off" keeps them from the initial guess (README).
   std::string base_link_from_motion = "off";
+
+  // rigcal: static calibration (`rigcal calibrate --static`, README): seconds of every lidar accumulated
+  // while the vehicle stands still, and how far the mapping lidar may move (against its first sweep)
+  // before the capture is refused.
+  double static_capture_s = 2.0;
+  double static_max_motion_m = 0.03;
+  double static_max_motion_deg = 0.3;
 };
 
 }  // namespace rigcal::config

@@ -22,7 +22,9 @@
 namespace rigcal::calib {
 
 struct GlobalSearchSettings {
-  double yaw_range_deg = 75.0;        // ± about the (levelled) guess
+  // ± about the (levelled) guess; 180 = the full turn, so a side lidar whose guess is 60° off (or a
+  // mount with no guess at all) still lands in its basin. The full turn costs 2.4× the ±75° it replaced.
+  double yaw_range_deg = 180.0;
   double yaw_step_deg = 3.0;
   double translation_range = 1.4;     // ± m along the ground, about the guess
   double translation_step = 0.2;
