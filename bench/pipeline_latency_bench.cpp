@@ -26,6 +26,12 @@
 #include "rigcal/pipeline/pipeline.hpp"
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/simulation.hpp"
+#include "rigcal/view/live_view.hpp"
+#include "rigcal/view/view_server.hpp"
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
 
 using namespace rigcal;
 namespace fs = std::filesystem;
@@ -65,8 +71,10 @@ std::vector<Scan> only(const std::vector<Scan>& all, const std::vector<std::stri
 }
 
 /// Feeds the scans at 1× their stamps (a scan is pushed when its last point would have arrived).
-pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector<Scan>& scans, std::uint64_t* registered) {
+pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector<Scan>& scans, std::uint64_t* registered,
+                                 std::shared_ptr<pipeline::PipelineObserver> observer = nullptr) {
   pipeline::PipelineOptions o;
+  o.observer = std::move(observer);
   o.mode = pipeline::PipelineMode::kRealtime;
   o.cores = {0, 1};
   pipeline::Pipeline p(rig, o);
@@ -81,6 +89,42 @@ pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector
   p.finish();
   *registered = p.progress().registered;
   return p.stats();
+}
+
+/// A browser stand-in: one WebSocket client reading everything the view sends, on its own thread.
+struct ViewClient {
+  explicit ViewClient(std::uint16_t port) {
+    thread = std::thread([this, port] {
+      namespace beast = boost::beast;
+      boost::asio::io_context io;
+      beast::websocket::stream<beast::tcp_stream> ws(io);
+      beast::error_code ec;
+      beast::get_lowest_layer(ws).connect({boost::asio::ip::make_address("127.0.0.1"), port}, ec);
+      if (!ec) ws.handshake("127.0.0.1", "/ws", ec);
+      while (!ec && !stop.load()) {
+        beast::get_lowest_layer(ws).expires_after(std::chrono::milliseconds(200));
+        beast::flat_buffer b;
+        ws.read(b, ec);
+        if (ec == beast::error::timeout) ec = {};
+        else if (!ec) bytes += b.size();
+      }
+    });
+  }
+  ~ViewClient() { stopAndJoin(); }
+  std::size_t stopAndJoin() {
+    stop.store(true);
+    if (thread.joinable()) thread.join();
+    return bytes;
+  }
+  std::atomic<bool> stop{false};
+  std::size_t bytes = 0;
+  std::thread thread;
+};
+
+double scanToPoseP99Ms(const pipeline::PipelineStats& stats) {
+  for (const auto& st : stats.stages)
+    if (st.name == "mapper") return ms(st.latency.quantile(0.99));
+  return 0;
 }
 
 }  // namespace
@@ -170,6 +214,37 @@ int main(int argc, char** argv) {
     std::printf("  dropped %llu, registered %llu of the mapping scans, CPU %.2f s over %.2f s wall\n",
                 static_cast<unsigned long long>(dropped), static_cast<unsigned long long>(registered), cpu,
                 stats.wall_seconds);
+  }
+
+  // The live view (--view) must not slow the pipeline: 3 lidars at 1x, alternately without and with a
+  // view whose one client reads everything, twice each, in this same run.
+  for (int round = 0; round < 2; ++round) {
+    for (const bool with_view : {false, true}) {
+      std::uint64_t registered = 0;
+      pipeline::PipelineStats stats;
+      std::size_t client_bytes = 0;
+      std::uint64_t view_dropped = 0;
+      if (with_view) {
+        view::ViewServer server(view::ViewEndpoint{"127.0.0.1", 0});
+        auto live = std::make_shared<view::LiveView>(server, "bench", rig.roles.calibration_lidars);
+        {
+          ViewClient client(server.port());
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));  // connected before the first scan
+          stats = realtime(rig, rec.scans, &registered, live);
+          live->finish();
+          std::this_thread::sleep_for(std::chrono::milliseconds(300));
+          client_bytes = client.stopAndJoin();
+        }
+        view_dropped = live->droppedUpdates();
+      } else {
+        stats = realtime(rig, rec.scans, &registered);
+      }
+      std::printf("1x real time, 3 lidars, %s: scan-to-pose p99 %.2f ms, registered %llu", with_view ? "live view + 1 client" : "no view           ",
+                  scanToPoseP99Ms(stats), static_cast<unsigned long long>(registered));
+      if (with_view) std::printf(", client got %.1f MB, view dropped %llu updates", double(client_bytes) / 1e6,
+                                 static_cast<unsigned long long>(view_dropped));
+      std::printf(" (loadavg %s)\n", loadavg().c_str());
+    }
   }
 
   // Offline: as fast as possible, lossless; the rate is recorded time / wall time.

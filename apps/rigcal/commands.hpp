@@ -26,5 +26,6 @@ void addCalibratePoseCommand(CLI::App& app);
 void addCalibrateCommand(CLI::App& app);
 void addInspectCommand(CLI::App& app);
 void addRegisterCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
 }  // namespace rigcal::app

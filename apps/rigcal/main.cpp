@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   addCalibrateCommand(app);
   addInspectCommand(app);
   addRegisterCommand(app);
+  addViewCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -22,6 +22,7 @@
 #include "../output_folder.hpp"
 #include "../pipeline_options.hpp"
 #include "../stop_signals.hpp"
+#include "../view_option.hpp"
 #include "rigcal/calib/base_from_motion.hpp"
 #include "rigcal/calib/base_lidar_calibration.hpp"
 #include "rigcal/calib/base_lidar_multi.hpp"
@@ -47,6 +48,7 @@ struct CalibrateOptions {
   std::string config, out = "rigcal-out";
   PipelineCliOptions pipeline;
   double deadline = -1.0;  // < 0: the rig's calibration_deadline_s
+  ViewCliOptions view;
 };
 
 /// Packet clocks further apart than this (each against the capture time) make a result unverified: at
@@ -67,9 +69,11 @@ void run(const CalibrateOptions& o) {
   const auto t_start = Clock::now();
   config::RigConfig rig = loadRig(o.config);
   if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
-  const pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
+  pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
   const bool realtime = po.mode == pipeline::PipelineMode::kRealtime;
   prepareOutputFolder(o.out);
+  CommandView view(o.view, "calibrate", rig);
+  view.attach(po);
 
   StopSignals signals;
   // Every calibration lidar shares one calibration_deadline_s, whenever its dataset comes (budget full
@@ -83,6 +87,7 @@ void run(const CalibrateOptions& o) {
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());
   }
+  const auto view_follows = view.follow(*pipe);
   // A one-line progress display, on a terminal only.
   std::atomic<bool> input_done{false};
   std::thread progress;
@@ -104,6 +109,7 @@ void run(const CalibrateOptions& o) {
   }
   input_done = true;
   if (progress.joinable()) progress.join();
+  view.finish();
   const double pipeline_seconds = since(t_start);
   const bool interrupted = StopSignals::requested();
   if (interrupted) std::cerr << "interrupted: input ended early; calibrating the lidars that have enough frames\n";
@@ -224,7 +230,9 @@ void run(const CalibrateOptions& o) {
     throw CommandFailed(kExitFailure, e.what());
   }
   if (!o.pipeline.stats_file.empty()) reportStats(o.pipeline, pipe->stats());
-  std::cout << calib::summaryTable(outcome) << "outputs in " << out.string() << "\n";
+  std::cout << calib::summaryTable(outcome) << "outputs in " << out.string() << "\n" << std::flush;
+  view.results(out, rig.roles.calibration_lidars);
+  view.hold();
 
   if (!shortfalls.empty()) {
     std::string msg = shortfalls.front().message;
@@ -251,6 +259,7 @@ void addCalibrateCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("calibrate", "Map with the mapping lidar and calibrate the rig (the main job).");
   cmd->add_option("--config", o->config, "rig YAML file")->required();
   addPipelineOptions(*cmd, o->pipeline);
+  addViewOptions(*cmd, o->view);
   cmd->add_option("--out", o->out, "output folder (default rigcal-out)");
   cmd->add_option("--deadline", o->deadline, "seconds for the lidar-lidar calibration (calibration_deadline_s)")
       ->check(CLI::NonNegativeNumber);
