@@ -183,6 +183,13 @@
         (sc.rmse_m || 0).toFixed(4), (sc.inlier_ratio || 0).toFixed(2)];
       for (const c of cells) row.insertCell().textContent = c;
     }
+    // `rigcal view OUT_DIR` has no live counters: show the report's.
+    if (!state.counters && r.input) {
+      for (const el of document.querySelectorAll('[data-counter]')) {
+        const key = el.getAttribute('data-counter');
+        if (key in r.input) setText(el, String(r.input[key]));
+      }
+    }
     if (r.status) setText(document.getElementById('status'), 'finished: ' + r.status);
     state.finished = true;
   }
