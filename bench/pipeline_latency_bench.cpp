@@ -4,7 +4,7 @@
 // (scan-to-pose compute time with nothing else running) — the floor the pipelined scan-to-pose p99 is
 // compared with. Plain main(): the pipeline's threads and the pacing do not fit Google Benchmark's loop.
 //
-//   taskset -c 0,1 build/bench/pipeline_latency_bench [--seconds 12]
+//   taskset -c 0,1 build/bench/pipeline_latency_bench [--seconds 12] [--baseline-only | --view-only]
 #include <sched.h>
 #include <unistd.h>
 
@@ -92,33 +92,36 @@ pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector
 }
 
 /// A browser stand-in: one WebSocket client reading everything the view sends, on its own thread.
-struct ViewClient {
-  explicit ViewClient(std::uint16_t port) {
-    thread = std::thread([this, port] {
-      namespace beast = boost::beast;
-      boost::asio::io_context io;
-      beast::websocket::stream<beast::tcp_stream> ws(io);
-      beast::error_code ec;
-      beast::get_lowest_layer(ws).connect({boost::asio::ip::make_address("127.0.0.1"), port}, ec);
-      if (!ec) ws.handshake("127.0.0.1", "/ws", ec);
-      while (!ec && !stop.load()) {
-        beast::get_lowest_layer(ws).expires_after(std::chrono::milliseconds(200));
-        beast::flat_buffer b;
-        ws.read(b, ec);
-        if (ec == beast::error::timeout) ec = {};
-        else if (!ec) bytes += b.size();
-      }
-    });
+class ViewClient {
+ public:
+  explicit ViewClient(std::uint16_t port) : ws_(io_) {
+    boost::beast::get_lowest_layer(ws_).connect({boost::asio::ip::make_address("127.0.0.1"), port});
+    ws_.handshake("127.0.0.1", "/ws");
+    readNext();
+    thread_ = std::thread([this] { io_.run(); });
   }
   ~ViewClient() { stopAndJoin(); }
+  /// Stops reading; returns the bytes received.
   std::size_t stopAndJoin() {
-    stop.store(true);
-    if (thread.joinable()) thread.join();
-    return bytes;
+    io_.stop();
+    if (thread_.joinable()) thread_.join();
+    return bytes_;
   }
-  std::atomic<bool> stop{false};
-  std::size_t bytes = 0;
-  std::thread thread;
+
+ private:
+  void readNext() {
+    ws_.async_read(buffer_, [this](boost::beast::error_code ec, std::size_t n) {
+      if (ec) return;
+      bytes_ += n;
+      buffer_.consume(buffer_.size());
+      readNext();
+    });
+  }
+  boost::asio::io_context io_;
+  boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
+  boost::beast::flat_buffer buffer_;
+  std::size_t bytes_ = 0;  // the client thread's until joined
+  std::thread thread_;
 };
 
 double scanToPoseP99Ms(const pipeline::PipelineStats& stats) {
@@ -130,11 +133,14 @@ double scanToPoseP99Ms(const pipeline::PipelineStats& stats) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress lines as they come, also into a file
   double seconds = 12.0;
   bool baseline_only = false;
+  bool view_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) seconds = std::stod(argv[i + 1]);
     if (std::strcmp(argv[i], "--baseline-only") == 0) baseline_only = true;
+    if (std::strcmp(argv[i], "--view-only") == 0) view_only = true;  // only the with/without live view rounds
   }
 
   sim::Simulation simulation(sim::loadScenario("parking-lot"));
@@ -196,6 +202,7 @@ int main(int argc, char** argv) {
   const std::vector<std::vector<std::string>> setups = {
       {"top"}, {"top", "front_left"}, {"top", "front_left", "front_right"}};
   for (const auto& sensors : setups) {
+    if (view_only) break;
     config::RigConfig r = rig;
     r.roles.calibration_lidars.assign(sensors.begin() + 1, sensors.end());
     const auto scans = only(rec.scans, sensors);
@@ -248,7 +255,7 @@ int main(int argc, char** argv) {
   }
 
   // Offline: as fast as possible, lossless; the rate is recorded time / wall time.
-  {
+  if (!view_only) {
     pipeline::PipelineOptions o;
     o.cores = {0, 1};
     const auto t0 = std::chrono::steady_clock::now();
