@@ -4,7 +4,7 @@
 // (scan-to-pose compute time with nothing else running) — the floor the pipelined scan-to-pose p99 is
 // compared with. Plain main(): the pipeline's threads and the pacing do not fit Google Benchmark's loop.
 //
-//   taskset -c 0,1 build/bench/pipeline_latency_bench [--seconds 12]
+//   taskset -c 0,1 build/bench/pipeline_latency_bench [--seconds 12] [--baseline-only | --view-only]
 #include <sched.h>
 #include <unistd.h>
 
@@ -26,6 +26,12 @@
 #include "rigcal/pipeline/pipeline.hpp"
 #include "rigcal/sim/outputs.hpp"
 #include "rigcal/sim/simulation.hpp"
+#include "rigcal/view/live_view.hpp"
+#include "rigcal/view/view_server.hpp"
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
 
 using namespace rigcal;
 namespace fs = std::filesystem;
@@ -65,8 +71,10 @@ std::vector<Scan> only(const std::vector<Scan>& all, const std::vector<std::stri
 }
 
 /// Feeds the scans at 1× their stamps (a scan is pushed when its last point would have arrived).
-pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector<Scan>& scans, std::uint64_t* registered) {
+pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector<Scan>& scans, std::uint64_t* registered,
+                                 std::shared_ptr<pipeline::PipelineObserver> observer = nullptr) {
   pipeline::PipelineOptions o;
+  o.observer = std::move(observer);
   o.mode = pipeline::PipelineMode::kRealtime;
   o.cores = {0, 1};
   pipeline::Pipeline p(rig, o);
@@ -83,14 +91,56 @@ pipeline::PipelineStats realtime(const config::RigConfig& rig, const std::vector
   return p.stats();
 }
 
+/// A browser stand-in: one WebSocket client reading everything the view sends, on its own thread.
+class ViewClient {
+ public:
+  explicit ViewClient(std::uint16_t port) : ws_(io_) {
+    boost::beast::get_lowest_layer(ws_).connect({boost::asio::ip::make_address("127.0.0.1"), port});
+    ws_.handshake("127.0.0.1", "/ws");
+    readNext();
+    thread_ = std::thread([this] { io_.run(); });
+  }
+  ~ViewClient() { stopAndJoin(); }
+  /// Stops reading; returns the bytes received.
+  std::size_t stopAndJoin() {
+    io_.stop();
+    if (thread_.joinable()) thread_.join();
+    return bytes_;
+  }
+
+ private:
+  void readNext() {
+    ws_.async_read(buffer_, [this](boost::beast::error_code ec, std::size_t n) {
+      if (ec) return;
+      bytes_ += n;
+      buffer_.consume(buffer_.size());
+      readNext();
+    });
+  }
+  boost::asio::io_context io_;
+  boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
+  boost::beast::flat_buffer buffer_;
+  std::size_t bytes_ = 0;  // the client thread's until joined
+  std::thread thread_;
+};
+
+double scanToPoseP99Ms(const pipeline::PipelineStats& stats) {
+  for (const auto& st : stats.stages)
+    if (st.name == "mapper") return ms(st.latency.quantile(0.99));
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress lines as they come, also into a file
   double seconds = 12.0;
   bool baseline_only = false;
+  bool view_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) seconds = std::stod(argv[i + 1]);
     if (std::strcmp(argv[i], "--baseline-only") == 0) baseline_only = true;
+    if (std::strcmp(argv[i], "--view-only") == 0) view_only = true;  // only the with/without live view rounds
   }
 
   sim::Simulation simulation(sim::loadScenario("parking-lot"));
@@ -152,6 +202,7 @@ int main(int argc, char** argv) {
   const std::vector<std::vector<std::string>> setups = {
       {"top"}, {"top", "front_left"}, {"top", "front_left", "front_right"}};
   for (const auto& sensors : setups) {
+    if (view_only) break;
     config::RigConfig r = rig;
     r.roles.calibration_lidars.assign(sensors.begin() + 1, sensors.end());
     const auto scans = only(rec.scans, sensors);
@@ -172,8 +223,39 @@ int main(int argc, char** argv) {
                 stats.wall_seconds);
   }
 
+  // The live view (--view) must not slow the pipeline: 3 lidars at 1x, alternately without and with a
+  // view whose one client reads everything, twice each, in this same run.
+  for (int round = 0; round < 2; ++round) {
+    for (const bool with_view : {false, true}) {
+      std::uint64_t registered = 0;
+      pipeline::PipelineStats stats;
+      std::size_t client_bytes = 0;
+      std::uint64_t view_dropped = 0;
+      if (with_view) {
+        view::ViewServer server(view::ViewEndpoint{"127.0.0.1", 0});
+        auto live = std::make_shared<view::LiveView>(server, "bench", rig.roles.calibration_lidars);
+        {
+          ViewClient client(server.port());
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));  // connected before the first scan
+          stats = realtime(rig, rec.scans, &registered, live);
+          live->finish();
+          std::this_thread::sleep_for(std::chrono::milliseconds(300));
+          client_bytes = client.stopAndJoin();
+        }
+        view_dropped = live->droppedUpdates();
+      } else {
+        stats = realtime(rig, rec.scans, &registered);
+      }
+      std::printf("1x real time, 3 lidars, %s: scan-to-pose p99 %.2f ms, registered %llu", with_view ? "live view + 1 client" : "no view           ",
+                  scanToPoseP99Ms(stats), static_cast<unsigned long long>(registered));
+      if (with_view) std::printf(", client got %.1f MB, view dropped %llu updates", double(client_bytes) / 1e6,
+                                 static_cast<unsigned long long>(view_dropped));
+      std::printf(" (loadavg %s)\n", loadavg().c_str());
+    }
+  }
+
   // Offline: as fast as possible, lossless; the rate is recorded time / wall time.
-  {
+  if (!view_only) {
     pipeline::PipelineOptions o;
     o.cores = {0, 1};
     const auto t0 = std::chrono::steady_clock::now();

@@ -27,5 +27,6 @@ void addCalibrateCommand(CLI::App& app);
 void addInspectCommand(CLI::App& app);
 void addRegisterCommand(CLI::App& app);
 void addRigFromBagCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
 }  // namespace rigcal::app

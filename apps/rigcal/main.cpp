@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   addInspectCommand(app);
   addRegisterCommand(app);
   addRigFromBagCommand(app);
+  addViewCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -106,6 +106,7 @@ void Pipeline::Impl::mapperStage() {
     if (f.isKeyframe()) keyframes.fetch_add(1);
     if (f.kind == FrameKind::kStopped || f.kind == FrameKind::kStoppedKeyframe) stopped.fetch_add(1);
     if (f.lost) lost.fetch_add(1);
+    if (options.observer) options.observer->onFrame(f, out.cloud);
     q_frames.push(FrameItem{std::move(out), false});
     wake_pairing.signal();
   }
@@ -215,6 +216,7 @@ void Pipeline::Impl::selectorStage() {
     lc.accepted.store(selection[lane].accepted());
     lc.selected.store(selection[lane].selected());
     rec_selector.record(t0);
+    if (options.observer) options.observer->onCandidate(selection[lane].lastCandidateEvent(int(lane)));
     if (d) deliver(d, lane);
     std::size_t bound = SIZE_MAX;
     for (const auto& s : selection)

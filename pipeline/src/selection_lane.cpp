@@ -97,3 +97,19 @@ Shortfall SelectionLane::shortfall() const {
 }
 
 }  // namespace rigcal::pipeline
+
+namespace rigcal::pipeline {
+
+CandidateEvent SelectionLane::lastCandidateEvent(int lane) const {
+  CandidateEvent e;
+  e.lane = lane;
+  if (records_.empty()) return e;
+  const Pairing& p = records_.back().c.pairing;
+  e.position = p.T_map_mapping_at_scan.translation().cast<float>();
+  e.accepted = p.accepted;
+  for (std::size_t id : selection_.selected)
+    e.selected.push_back(records_[id].c.pairing.T_map_mapping_at_scan.translation().cast<float>());
+  return e;
+}
+
+}  // namespace rigcal::pipeline

@@ -12,6 +12,7 @@
 #include "pairing_lane.hpp"
 #include "rigcal/pipeline/calibration_dataset.hpp"
 #include "rigcal/pipeline/pipeline.hpp"
+#include "rigcal/pipeline/pipeline_observer.hpp"
 
 namespace rigcal::pipeline {
 
@@ -35,6 +36,8 @@ class SelectionLane {
   [[nodiscard]] std::size_t accepted() const { return accepted_; }
   [[nodiscard]] std::size_t selected() const { return selection_.selected.size(); }
   [[nodiscard]] Shortfall shortfall() const;
+  /// The latest candidate and the current selection, for a PipelineObserver.
+  [[nodiscard]] CandidateEvent lastCandidateEvent(int lane) const;
 
  private:
   struct Record {

@@ -24,6 +24,8 @@
 #include "../output_folder.hpp"
 #include "../pipeline_options.hpp"
 #include "../stop_signals.hpp"
+#include "../time_offsets.hpp"
+#include "../view_option.hpp"
 #include "rigcal/calib/base_lidar/base_from_motion.hpp"
 #include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
 #include "rigcal/calib/base_lidar/base_lidar_multi.hpp"
@@ -36,7 +38,6 @@
 #include "rigcal/calib/outputs/overview_png_writer.hpp"
 #include "rigcal/calib/outputs/report_json_writer.hpp"
 #include "rigcal/calib/outputs/summary_table.hpp"
-#include "../time_offsets.hpp"
 #include "rigcal/config/config_error.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/pipeline/clock_offset_estimate.hpp"
@@ -52,6 +53,7 @@ struct CalibrateOptions {
   PipelineCliOptions pipeline;
   double deadline = -1.0;  // < 0: the rig's calibration_deadline_s
   bool static_vehicle = false;  // --static: a parked vehicle (calibrate_static_command.cpp)
+  ViewCliOptions view;
 };
 
 /// Packet clocks further apart than this (each against the capture time) make a result unverified: at
@@ -72,7 +74,7 @@ void run(const CalibrateOptions& o) {
   const auto t_start = Clock::now();
   config::RigConfig rig = loadRig(o.config);
   if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
-  const pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
+  pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
   applyExtrinsicsFromBag(rig, po);
   const bool realtime = po.mode == pipeline::PipelineMode::kRealtime;
   prepareOutputFolder(o.out);
@@ -84,6 +86,8 @@ void run(const CalibrateOptions& o) {
     throw CommandFailed(kExitInput, e.what());
   }
   for (const auto& line : time_offset_lines) std::cerr << line << "\n";
+  CommandView view(o.view, "calibrate", rig);
+  view.attach(po);
 
   StopSignals signals;
   // Every calibration lidar shares one calibration_deadline_s, whenever its dataset comes (budget full
@@ -97,6 +101,7 @@ void run(const CalibrateOptions& o) {
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());
   }
+  const auto view_follows = view.follow(*pipe);
   // A one-line progress display, on a terminal only.
   std::atomic<bool> input_done{false};
   std::thread progress;
@@ -118,6 +123,7 @@ void run(const CalibrateOptions& o) {
   }
   input_done = true;
   if (progress.joinable()) progress.join();
+  view.finish();
   const double pipeline_seconds = since(t_start);
   const bool interrupted = StopSignals::requested();
   if (interrupted) std::cerr << "interrupted: input ended early; calibrating the lidars that have enough frames\n";
@@ -264,7 +270,9 @@ void run(const CalibrateOptions& o) {
     throw CommandFailed(kExitFailure, e.what());
   }
   if (!o.pipeline.stats_file.empty()) reportStats(o.pipeline, pipe->stats());
-  std::cout << calib::summaryTable(outcome) << "outputs in " << out.string() << "\n";
+  std::cout << calib::summaryTable(outcome) << "outputs in " << out.string() << "\n" << std::flush;
+  view.results(out, rig.roles.calibration_lidars);
+  view.hold();
 
   if (!shortfalls.empty()) {
     std::string msg = shortfalls.front().message;
@@ -291,6 +299,7 @@ void addCalibrateCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("calibrate", "Map with the mapping lidar and calibrate the rig (the main job).");
   cmd->add_option("--config", o->config, "rig YAML file")->required();
   addPipelineOptions(*cmd, o->pipeline);
+  addViewOptions(*cmd, o->view);
   cmd->add_option("--out", o->out, "output folder (default rigcal-out)");
   cmd->add_option("--deadline", o->deadline, "seconds for the lidar-lidar calibration (calibration_deadline_s)")
       ->check(CLI::NonNegativeNumber);

@@ -19,6 +19,7 @@
 #include "../output_folder.hpp"
 #include "../pipeline_options.hpp"
 #include "../stop_signals.hpp"
+#include "../view_option.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/core/pcd_io.hpp"
 #include "rigcal/core/point_table.hpp"
@@ -32,6 +33,7 @@ namespace fs = std::filesystem;
 struct MapArgs {
   std::string config, out;
   PipelineCliOptions pipeline;
+  ViewCliOptions view;
 };
 
 void writeTrajectory(const fs::path& file, const pipeline::MappingResult& m) {
@@ -71,9 +73,11 @@ void writeSelection(const fs::path& file, const std::vector<std::shared_ptr<cons
 
 void run(const MapArgs& a) {
   config::RigConfig rig = loadRig(a.config);
-  const pipeline::PipelineOptions options = toPipelineOptions(a.pipeline);
+  pipeline::PipelineOptions options = toPipelineOptions(a.pipeline);
   applyExtrinsicsFromBag(rig, options);
   if (!a.out.empty()) prepareOutputFolder(a.out);
+  CommandView view(a.view, "map", rig);
+  view.attach(options);
 
   std::mutex m;
   std::vector<std::shared_ptr<const pipeline::CalibrationDataset>> datasets;
@@ -90,6 +94,7 @@ void run(const MapArgs& a) {
     throw CommandFailed(kExitInput, e.what());
   }
 
+  const auto view_follows = view.follow(*p);
   // A one-line progress display on a terminal.
   std::atomic<bool> done{false};
   std::thread progress;
@@ -105,6 +110,7 @@ void run(const MapArgs& a) {
   p->run(StopSignals::flag());
   done.store(true);
   if (progress.joinable()) progress.join();
+  view.finish();
 
   const pipeline::MappingResult mapping = p->mapping();
   const auto shortfalls = p->shortfalls();
@@ -124,6 +130,7 @@ void run(const MapArgs& a) {
     std::cout << "wrote trajectory.csv (" << mapping.trajectory.size() << " frames), map.pcd ("
               << mapping.map_cloud->size() << " points), selection.txt to " << a.out << '\n';
   }
+  view.hold();
   if (mapping.trajectory.empty()) throw CommandFailed(kExitNotEnoughData, "no mapping-lidar scan was registered");
   if (StopSignals::requested() && pipeline::isRecording(options.input))
     throw CommandFailed(kExitInterrupted, "map interrupted (outputs hold what was mapped)");
@@ -136,6 +143,7 @@ void addMapCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("map", "Run the online pipeline (mapping, keyframes, pairing, selection) and write the map");
   cmd->add_option("--config", a->config, "Rig YAML file")->required();
   addPipelineOptions(*cmd, a->pipeline);
+  addViewOptions(*cmd, a->view);
   cmd->add_option("--out", a->out, "Write trajectory.csv, map.pcd and selection.txt here");
   cmd->footer(std::string("Stops at the end of the capture, or on Ctrl-C. ") + kExitCodesHelp);
   cmd->callback([a] { run(*a); });

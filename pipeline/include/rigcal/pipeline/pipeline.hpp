@@ -25,6 +25,7 @@
 #include "rigcal/pipeline/calibration_dataset.hpp"
 #include "rigcal/pipeline/latency_histogram.hpp"
 #include "rigcal/pipeline/mapping_frame.hpp"
+#include "rigcal/pipeline/pipeline_observer.hpp"
 
 namespace rigcal::pipeline {
 
@@ -57,6 +58,7 @@ struct PipelineOptions {
   bool wait_for_writers = false;           // kShm: keep waiting when every ring writer is gone
   std::vector<int> cores;                  // pin every pipeline thread to these cores (empty: no pinning)
   std::size_t queue_capacity = 32;         // per queue, in scans
+  std::shared_ptr<PipelineObserver> observer;  // the live view (optional): called on the stage threads
 };
 
 /// Per calibration lidar.

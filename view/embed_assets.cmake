@@ -1,0 +1,16 @@
+# cmake -DOUT=static_assets.hpp -DASSETS_DIR=assets -P embed_assets.cmake: the page's files as
+# std::string_view constants (raw string literals; the delimiter must not occur in the files).
+set(text "#pragma once\n// Generated from view/assets by view/embed_assets.cmake: do not edit.\n#include <string_view>\n\nnamespace rigcal::view::assets {\n")
+foreach(pair "kIndexHtml;index.html" "kViewJs;view.js" "kViewCss;view.css")
+  list(GET pair 0 name)
+  list(GET pair 1 file)
+  file(READ ${ASSETS_DIR}/${file} content)
+  string(FIND "${content}" ")rigcal_asset\"" clash)
+  if(NOT clash EQUAL -1)
+    message(FATAL_ERROR "${file} contains the raw-string delimiter")
+  endif()
+  string(APPEND text "inline constexpr std::string_view ${name} = R\"rigcal_asset(${content})rigcal_asset\";\n")
+endforeach()
+string(APPEND text "}  // namespace rigcal::view::assets\n")
+file(WRITE ${OUT}.tmp "${text}")
+file(RENAME ${OUT}.tmp ${OUT})
