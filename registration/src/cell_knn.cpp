@@ -96,7 +96,7 @@ float anchorBound(const Anchor& a, float qx, float qy, float qz) {
 }  // namespace
 
 bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_threads, bool tree_at_hand,
-             CellKnn* out) {
+             CellKnn* out, const Deadline& stop) {
   const std::size_t n = points.size();
   if (k == 0 || n < 4 * k) return false;
   Eigen::Vector3d lo = points[0].head<3>(), hi = lo;
@@ -160,6 +160,7 @@ bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_thr
   parallelFor(chunkCount(cells, kCellsPerTask), num_threads, [&](std::size_t task) {
     std::vector<float> xs, ys, zs;
     std::vector<std::uint32_t> ids;
+    if (tree_at_hand && stop.expired()) return;  // skipped cells stay unproven with no neighbours
     const std::size_t first = task * kCellsPerTask;
     const std::size_t last = std::min(cells, first + kCellsPerTask);
     for (std::size_t c = first; c < last; ++c) {

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "rigcal/registration/deadline.hpp"
 #include "rigcal/registration/nearest_neighbors.hpp"
 
 namespace rigcal::registration::detail {
@@ -29,7 +30,9 @@ struct CellKnn {
 /// unspecified) when a grid does not suit the cloud (too few points, or an extent no cell size covers);
 /// then use the tree for everything. `tree_at_hand`: the caller already has a tree, so what the 3x3x3
 /// block cannot prove is listed as unproven at once instead of searched further on the grid.
+/// `stop` (with a tree at hand): once it expires the remaining cells are skipped, their points left with
+/// no neighbours and unproven; the caller, seeing it expired, discards the result.
 bool cellKnn(std::span<const Eigen::Vector4d> points, std::size_t k, int num_threads, bool tree_at_hand,
-             CellKnn* out);
+             CellKnn* out, const Deadline& stop = {});
 
 }  // namespace rigcal::registration::detail

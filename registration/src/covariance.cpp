@@ -84,10 +84,11 @@ bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t
 // Every point's k nearest (itself among them), closest first: the cell grid for all it can prove, the
 // tree for the rest (sparse outskirts) or for everything when a grid does not suit the cloud. `tree`, when
 // given, must be over cloud.points; otherwise one is built only if some point needs it.
-detail::CellKnn allNearest(const PointCloud& cloud, std::size_t k, int num_threads, const KdTree* tree) {
+detail::CellKnn allNearest(const PointCloud& cloud, std::size_t k, int num_threads, const KdTree* tree,
+                           const Deadline& stop = {}) {
   const std::size_t n = cloud.size();
   detail::CellKnn knn;
-  const bool grid = detail::cellKnn(cloud.points, k, num_threads, tree != nullptr, &knn);
+  const bool grid = detail::cellKnn(cloud.points, k, num_threads, tree != nullptr, &knn, stop);
   if (!grid) {
     knn.k = k;
     knn.neighbors.assign(n * k, Neighbor{});
@@ -105,6 +106,7 @@ detail::CellKnn allNearest(const PointCloud& cloud, std::size_t k, int num_threa
   }
   const std::size_t m = knn.unproven.size();
   parallelFor(chunkCount(m, kDefaultChunk), num_threads, [&](std::size_t task) {
+    if (stop.expired()) return;  // left without neighbours: the caller discards the result
     for (std::size_t u = task * kDefaultChunk; u < std::min(m, (task + 1) * kDefaultChunk); ++u) {
       const std::uint32_t i = knn.unproven[u];
       knn.count[i] = static_cast<std::uint32_t>(tree->knn(cloud.points[i], k, knn.neighbors.data() + i * k));
@@ -130,6 +132,7 @@ CovarianceStats shapesAndGraph(PointCloud& cloud, const detail::CellKnn& knn, st
   cloud.covariances.assign(n, Eigen::Matrix4d::Zero());
   std::atomic<std::size_t> isolated{0};
   parallelFor(chunkCount(n, kDefaultChunk), options.num_threads, [&](std::size_t task) {
+    if (options.deadline.expired()) return;
     std::size_t local_isolated = 0;
     for (std::size_t i = task * kDefaultChunk; i < std::min(n, (task + 1) * kDefaultChunk); ++i) {
       const Neighbor* nb = knn.neighbors.data() + i * k_query;
@@ -161,7 +164,8 @@ CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const
   const std::size_t k = static_cast<std::size_t>(std::max(options.num_neighbors, 3));
   const std::size_t degree = graph != nullptr ? graph_degree : 0;
   const std::size_t k_query = std::max(k, degree + 2);  // the graph wants itself, `degree` others and the next
-  const detail::CellKnn knn = allNearest(cloud, k_query, options.num_threads, &tree);
+  const detail::CellKnn knn = allNearest(cloud, k_query, options.num_threads, &tree, options.deadline);
+  if (options.deadline.expired()) return {cloud.size(), 0};  // incomplete neighbours: never read them
   return shapesAndGraph(cloud, knn, k, options, graph, degree);
 }
 

@@ -22,6 +22,10 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
   KdTreeOptions tree_options = options.tree;
   tree_options.num_threads = options.num_threads;
   tree_ = KdTree(cloud_.points, tree_options);
+  if (options.deadline.expired()) {
+    stopped_ = true;
+    return;
+  }
   const std::vector<std::uint32_t>& order = tree_.leafOrder();
   PointCloud sorted;
   sorted.points.resize(order.size());
@@ -40,6 +44,7 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
   if (!cloud_.empty() && (want_graph || options.normals_and_covariances)) {
     CovarianceOptions cov = options.covariance;
     cov.num_threads = options.num_threads;
+    cov.deadline = options.deadline;
     if (options.normals_and_covariances && !(cloud_.hasNormals() && cloud_.hasCovariances())) {
       estimateCovariances(cloud_, tree_, cov, &graph_, options.neighbor_graph_degree);
     } else {
@@ -51,6 +56,10 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
       estimateCovariances(scratch, tree_, cov, &graph_, options.neighbor_graph_degree);
     }
   }
+  if (options.deadline.expired()) {
+    stopped_ = true;
+    return;
+  }
   if (cloud_.hasCovariances()) {
     covariance_upper_.reserve(6 * cloud_.size());
     for (const Eigen::Matrix4d& c : cloud_.covariances) {
@@ -60,6 +69,10 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
   }
   for (const double resolution : options.ndt_resolutions) {
     if (ndtGrid(resolution) != nullptr) continue;
+    if (options.deadline.expired()) {
+      stopped_ = true;
+      return;
+    }
     NdtGridOptions ndt = options.ndt;
     ndt.resolution = resolution;
     grids_.emplace_back(cloud_, ndt);

@@ -206,5 +206,25 @@ TEST(CalibrationBudget, ExpectRunsHandsTheRestToThoseStillToCome) {
   EXPECT_EQ(unlimited.next().when(), registration::Deadline::Clock::time_point::max());
 }
 
+// An offline replay waits in its dataset callback until the calibration is done (so that it has both cores):
+// waitIdle returns only once every dataset added so far is calibrated, and at once when there is none.
+TEST_F(LidarLidarWorkerSim, WaitIdleReturnsOnceEveryDatasetAddedIsCalibrated) {
+  config::Parameters params = data().params;
+  params.calibration_deadline_s = 0.3;
+  LidarLidarWorker worker(params, 2);
+  worker.waitIdle();  // nothing added: returns at once
+  EXPECT_EQ(worker.completed(), 0u);
+  worker.add(dataset(0));
+  worker.waitIdle();
+  EXPECT_EQ(worker.started(), 1u);
+  EXPECT_EQ(worker.completed(), 1u);
+  worker.add(dataset(1));
+  worker.waitIdle();
+  EXPECT_EQ(worker.completed(), 2u);
+  worker.finish();
+  ASSERT_EQ(worker.results.size(), 2u);
+  for (const auto& r : worker.results) expectResultOrDeadline(r);
+}
+
 }  // namespace
 }  // namespace rigcal::calib

@@ -97,6 +97,9 @@ void run(const CalibrateOptions& o) {
   try {
     pipe = std::make_unique<pipeline::Pipeline>(rig, po, [&](std::shared_ptr<const pipeline::CalibrationDataset> d) {
       worker.add(std::move(d));
+      // Offline (a pcap as fast as possible) nothing is lost by waiting: mapping pauses while a lidar is
+      // calibrated, which then has both cores for its share of the deadline.
+      if (!realtime) worker.waitIdle();
     });
   } catch (const std::exception& e) {
     throw CommandFailed(kExitInput, e.what());

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
-#include "rigcal/registration/voxel_grid.hpp"
+#include "rigcal/registration/voxel_accumulator.hpp"
 
 namespace rigcal::calib {
 
@@ -74,23 +76,30 @@ registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& data
   box_max.array() += margin;
 
   const Pose T_scan_map = dataset.frames[frame].pairing.T_map_mapping_at_scan.inverse();
-  registration::PointCloud cropped;
+  // Each cloud is cropped and voxelised before the next (the same centroids as voxelising the whole crop
+  // at once), so the deadline is looked at between clouds for all of the work.
+  std::optional<registration::VoxelAccumulator> voxels;
+  std::vector<Eigen::Vector4d> cropped;
   for (const std::size_t i : window) {
     if (options.deadline.expired()) return {};
     const auto& mc = dataset.mapping_clouds[i];
     const Eigen::Matrix4f T = (T_scan_map * mc.frame.T_map_lidar).matrix().cast<float>();
     const Scan& s = *mc.cloud;
+    cropped.clear();
     for (std::size_t j = 0; j < s.size(); ++j) {
       const Eigen::Vector4f q = T * Eigen::Vector4f(s.x[j], s.y[j], s.z[j], 1.0F);
       const Eigen::Vector3d qd = q.head<3>().cast<double>();
-      if ((qd.array() < box_min.array()).any() || (qd.array() > box_max.array()).any()) continue;  // NaN fails too
-      cropped.add(qd.x(), qd.y(), qd.z());
+      if (!qd.allFinite() || (qd.array() < box_min.array()).any() || (qd.array() > box_max.array()).any()) continue;
+      cropped.emplace_back(qd.x(), qd.y(), qd.z(), 1.0);
     }
+    if (cropped.empty()) continue;
+    if (!voxels) voxels.emplace(params.leaf_size_dense_map, cropped.size() * window.size());
+    voxels->add(cropped);
   }
   if (clouds_used != nullptr) *clouds_used = window.size();
-  if (points_before_voxel != nullptr) *points_before_voxel = cropped.size();
-  if (cropped.empty()) return cropped;
-  return registration::voxelDownsample(cropped, params.leaf_size_dense_map);
+  if (points_before_voxel != nullptr) *points_before_voxel = voxels ? voxels->added() : 0;
+  if (!voxels) return {};
+  return voxels->centroids();
 }
 
 AugmentedTarget buildAugmentedTarget(const pipeline::CalibrationDataset& dataset, std::size_t frame,

@@ -37,7 +37,15 @@ void Calibrator::run() {
       out_.deadline_reached = true;
       break;
     }
+    const std::size_t built = frames_.size();
     buildFrame(next++);
+    target_seconds += since(t);
+    // Its own view of the best at once (one ICP), before the next target: if the deadline cuts the
+    // targets, the frames built so far still count as evidence for the verdict (lidar_lidar_verdict.hpp).
+    t = Clock::now();
+    if (frames_.size() > built && !stopped()) confirmOnFrame(frames_.size() - 1);
+    ensemble_seconds += since(t);
+    t = Clock::now();
   }
   target_seconds += since(t);
   // Rescoring the guess and the best over the grown set costs two scores of the new size.
@@ -49,11 +57,6 @@ void Calibrator::run() {
     out_.frames_used.resize(first_frames);
     out_.deadline_reached = true;
   }
-  // Every other frame's own view of the best, cheaply (one ICP each), before the batched ICP and the full
-  // ensembles the deadline may cut: the evidence the verdict needs (frames that agree, lidar_lidar_verdict.hpp).
-  t = Clock::now();
-  for (std::size_t k = 1; k < frames_.size() && !stopped(); ++k) confirmOnFrame(k);
-  ensemble_seconds += since(t);
   t = Clock::now();
   if (!stopped()) batchedChain(best_);
   batched_seconds += since(t);

@@ -69,7 +69,7 @@ void Calibrator::buildFrame(std::size_t i) {
     cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds, &cropped);
     if (stopped()) return;
   }
-  // Do not start a build that the deadline would cut (a Target cannot be interrupted).
+  // Do not start a build that the deadline would cut (wasted work: the build stops at the deadline).
   if (!fits(deadline_, seconds_per_point_ * double(cloud.size()))) {
     out_.deadline_reached = true;
     return;
@@ -84,7 +84,12 @@ void Calibrator::buildFrame(std::size_t i) {
   topt.normals_and_covariances = true;
   topt.ndt_resolutions = {to.ndt_resolution};
   topt.num_threads = opt_.num_threads;
+  topt.deadline = deadline_;  // on a busy machine a build can take several times its estimate
   f.target = std::make_shared<const Target>(std::move(cloud), topt);
+  if (f.target->stopped()) {
+    out_.deadline_reached = true;
+    return;
+  }
   seconds_per_point_ = since(tb) / n;
   last_build_seconds_ = since(tb);
   out_.frames_used.push_back(i);

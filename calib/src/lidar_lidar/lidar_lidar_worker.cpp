@@ -40,6 +40,11 @@ std::size_t LidarLidarWorker::completed() const {
   return completed_;
 }
 
+void LidarLidarWorker::waitIdle() {
+  std::unique_lock lock(mutex_);
+  idle_.wait(lock, [&] { return pending_.empty() && completed_ == started_; });
+}
+
 void LidarLidarWorker::loop() {
   for (;;) {
     std::shared_ptr<const pipeline::CalibrationDataset> dataset;
@@ -59,8 +64,11 @@ void LidarLidarWorker::loop() {
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     results.push_back(std::move(result));
     datasets.push_back(*dataset);
-    const std::lock_guard lock(mutex_);
-    ++completed_;
+    {
+      const std::lock_guard lock(mutex_);
+      ++completed_;
+    }
+    idle_.notify_all();
   }
 }
 

@@ -5,6 +5,7 @@
 // normal, so point-to-plane-like residuals whatever the point density.
 #include <cstddef>
 
+#include "rigcal/registration/deadline.hpp"
 #include "rigcal/registration/nearest_neighbors.hpp"
 #include "rigcal/registration/point_cloud.hpp"
 
@@ -14,6 +15,9 @@ struct CovarianceOptions {
   int num_neighbors = 10;        // k; PCL GICP uses 20, small_gicp 10: about as accurate on our scans, half the cost
   double plane_epsilon = 1e-3;   // PCL GICP's gicp_epsilon
   int num_threads = 1;
+  /// Once expired the rest of the work is skipped (between chunks of a few hundred points) and the
+  /// normals/covariances are incomplete: a caller that set it checks it and discards the cloud.
+  Deadline deadline;
 };
 
 struct CovarianceStats {

@@ -24,6 +24,9 @@ struct TargetOptions {
   NdtGridOptions ndt;                    // its resolution is overridden by each entry above
   KdTreeOptions tree;
   int num_threads = 1;
+  /// A build that would outlast a calibration's deadline stops once this expires (between its steps and
+  /// between chunks of the neighbour search and covariances) and leaves an incomplete target: stopped().
+  Deadline deadline;
 };
 
 class Target {
@@ -46,6 +49,8 @@ class Target {
   /// The grid built for this resolution (within 1e-9 m), or nullptr.
   [[nodiscard]] const NdtGrid* ndtGrid(double resolution) const;
   [[nodiscard]] std::size_t droppedNonFinite() const { return dropped_; }
+  /// TargetOptions::deadline expired during the build: the target is incomplete and must not be used.
+  [[nodiscard]] bool stopped() const { return stopped_; }
   /// Each covariance's upper triangle (xx, xy, xz, yy, yz, zz), 6 doubles per point in cloud() order, or
   /// empty without covariances. GICP reads these: 48 bytes instead of a Matrix4d's 128 per match, which
   /// on a dense map decides how much of it stays in cache.
@@ -61,6 +66,7 @@ class Target {
   NeighborGraph graph_;
   std::vector<NdtGrid> grids_;
   std::size_t dropped_ = 0;
+  bool stopped_ = false;
   std::vector<double> covariance_upper_;
   std::vector<float> covariance_upper_float_;
 };

@@ -34,6 +34,10 @@ class LidarLidarWorker {
   /// Datasets whose calibration has started / is done so far (any thread).
   [[nodiscard]] std::size_t started() const;
   [[nodiscard]] std::size_t completed() const;
+  /// Blocks until every dataset added so far is calibrated. An offline replay calls it from the dataset
+  /// callback: the lossless pipeline then waits (its queues fill and the pcap reader pauses), so the
+  /// calibration has both cores for its whole budget instead of sharing them with mapping at full speed.
+  void waitIdle();
 
   /// After finish(): the datasets in the order they were calibrated, their results, and the calibration
   /// seconds spent (waits for datasets excluded: what calibration_deadline_s bounds).
@@ -49,6 +53,7 @@ class LidarLidarWorker {
   CalibrationBudget budget_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
+  std::condition_variable idle_;  // a calibration completed
   std::deque<std::shared_ptr<const pipeline::CalibrationDataset>> pending_;
   bool input_done_ = false;
   std::size_t started_ = 0, completed_ = 0;
