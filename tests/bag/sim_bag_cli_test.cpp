@@ -208,8 +208,9 @@ TEST_F(SimBag, RigFromAPointCloud2BagRunsAsWritten) {
   ASSERT_EQ(got["sensors"].size(), std::size(kSensors));
   for (std::size_t i = 0; i < std::size(kSensors); ++i) {
     const YAML::Node s = got["sensors"][i];
-    EXPECT_EQ(s["model"].as<std::string>(), "PointCloud2") << s["name"];
-    EXPECT_EQ(s["source"]["topic"].as<std::string>(), "/" + s["name"].as<std::string>() + "/points");
+    const std::string name = s["name"].as<std::string>();
+    EXPECT_EQ(s["model"].as<std::string>(), "PointCloud2") << name;
+    EXPECT_EQ(s["source"]["topic"].as<std::string>(), "/" + name + "/points");
   }
   const auto checked = runRigcal({"check-config", rig.string()});
   EXPECT_EQ(checked.exit_code, 0) << checked.out << checked.err;
