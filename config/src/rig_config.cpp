@@ -1,17 +1,16 @@
 #include "rigcal/config/rig_config.hpp"
 
-#include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <utility>
 
 #include "parameter_table.hpp"
+#include "yaml_node_reader.hpp"
 
 namespace rigcal::config {
 
@@ -23,130 +22,7 @@ const SensorConfig& RigConfig::sensor(const std::string& name) const {
 
 namespace {
 
-// Walks the YAML tree and turns every mistake into a ConfigError at the offending node.
-class Reader {
- public:
-  explicit Reader(std::filesystem::path file) : file_(std::move(file)) {}
-
-  [[nodiscard]] SourceLocation at(const YAML::Node& node) const {
-    const YAML::Mark m = node.Mark();
-    if (m.is_null()) return {file_};
-    return {file_, m.line + 1, m.column + 1};
-  }
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
-    throw ConfigError(at(node), what);
-  }
-
-  void requireMap(const YAML::Node& node, const std::string& what) const {
-    if (!node.IsMap()) fail(node, what + " must be a mapping of key: value");
-  }
-
-  /// Refuses keys outside `allowed`, naming the closest allowed one.
-  void checkKeys(const YAML::Node& map, const std::vector<std::string>& allowed,
-                 const std::string& section) const {
-    for (const auto& kv : map) {
-      const std::string key = kv.first.as<std::string>();
-      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-      std::string msg = "unknown key '" + key + "' in " + section;
-      if (const std::string near = closestName(key, allowed); !near.empty())
-        msg += " (did you mean '" + near + "'?)";
-      fail(kv.first, msg);
-    }
-  }
-
-  const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& section) const {
-    const YAML::Node n = map[key];
-    if (!n) fail(map, section + " needs '" + key + "'");
-    return n;
-  }
-
-  std::string text(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, "'" + key + "' must be a string");
-    return n.as<std::string>();
-  }
-
-  double number(const YAML::Node& n, const std::string& key) const {
-    double v = 0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
-      fail(n, "'" + key + "' must be a finite number, got '" + scalarText(n) + "'");
-    return v;
-  }
-
-  long long integer(const YAML::Node& n, const std::string& key) const {
-    long long v = 0;
-    if (!n.IsScalar() || !YAML::convert<long long>::decode(n, v))
-      fail(n, "'" + key + "' must be an integer, got '" + scalarText(n) + "'");
-    return v;
-  }
-
-  bool boolean(const YAML::Node& n, const std::string& key) const {
-    bool v = false;
-    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
-      fail(n, "'" + key + "' must be true or false, got '" + scalarText(n) + "'");
-    return v;
-  }
-
-  void inRange(const YAML::Node& n, const std::string& key, double v, double lo, double hi) const {
-    if (v < lo || v > hi) {
-      std::ostringstream msg;
-      msg << "'" << key << "' = " << v << " is out of range; allowed [" << lo << ", " << hi << "]";
-      fail(n, msg.str());
-    }
-  }
-
-  /// A file the config refers to: resolved against the config's folder; it must be a readable regular
-  /// file no larger than kMaxReferencedFileBytes (not a folder, a device, a pipe).
-  std::filesystem::path existingFile(const YAML::Node& n, const std::string& key) const {
-    std::filesystem::path p = text(n, key);
-    if (p.is_relative()) p = file_.parent_path() / p;
-    p = p.lexically_normal();
-    const std::string named = key + " file '" + n.as<std::string>() + "'";
-    std::error_code ec;
-    const auto status = std::filesystem::status(p, ec);
-    if (!std::filesystem::exists(status))
-      fail(n, named + " not found (looked for " + p.string() + ")");
-    if (!std::filesystem::is_regular_file(status))
-      fail(n, named + " is not a regular file (" + p.string() + ")");
-    if (const auto size = std::filesystem::file_size(p, ec); !ec && size > kMaxReferencedFileBytes)
-      fail(n, named + " is " + std::to_string(size) + " bytes; the limit is " +
-                  std::to_string(kMaxReferencedFileBytes) + " (" + p.string() + ")");
-    if (!std::ifstream(p, std::ios::binary)) fail(n, named + " is not readable (" + p.string() + ")");
-    return p;
-  }
-
-  /// An IPv4 address in dotted form; `multicast` also requires 224.0.0.0/4.
-  std::string ipv4(const YAML::Node& n, const std::string& key, bool multicast = false) const {
-    const std::string v = text(n, key);
-    in_addr a{};
-    if (inet_pton(AF_INET, v.c_str(), &a) != 1) fail(n, "'" + key + "' = '" + v + "' is not an IPv4 address");
-    if (multicast && (ntohl(a.s_addr) >> 28) != 0xE)
-      fail(n, "'" + key + "' = '" + v + "' is not a multicast address (224.0.0.0 to 239.255.255.255)");
-    return v;
-  }
-
-  /// Refuses a mapping that names the same key twice (yaml-cpp would keep one silently), anywhere.
-  void checkDuplicateKeys(const YAML::Node& node) const {
-    if (node.IsSequence()) {
-      for (const auto& child : node) checkDuplicateKeys(child);
-    } else if (node.IsMap()) {
-      std::set<std::string> seen;
-      for (const auto& kv : node) {
-        if (kv.first.IsScalar() && !seen.insert(kv.first.Scalar()).second)
-          fail(kv.first, "key '" + kv.first.Scalar() + "' appears twice in the same mapping");
-        checkDuplicateKeys(kv.second);
-      }
-    }
-  }
-
- private:
-  static std::string scalarText(const YAML::Node& n) {
-    if (n.IsScalar()) return n.Scalar();
-    return n.IsSequence() ? "a list" : n.IsMap() ? "a mapping" : "nothing";
-  }
-  std::filesystem::path file_;
-};
-
-SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
+SensorConfig readSensor(const YamlNodeReader& r, const YAML::Node& n) {
   r.requireMap(n, "a sensor");
   r.checkKeys(n, {"name", "model", "source", "calibration", "metadata", "time_source", "cut_angle",
                   "time_offset_ns"},
@@ -218,7 +94,7 @@ SensorConfig readSensor(const Reader& r, const YAML::Node& n) {
   return s;
 }
 
-Pose readExtrinsic(const Reader& r, const YAML::Node& n, const std::string& sensor) {
+Pose readExtrinsic(const YamlNodeReader& r, const YAML::Node& n, const std::string& sensor) {
   r.requireMap(n, "the initial extrinsic of '" + sensor + "'");
   const std::vector<std::string> keys = {"x", "y", "z", "roll", "pitch", "yaw"};
   r.checkKeys(n, keys, "initial_extrinsics of '" + sensor + "'");
@@ -231,7 +107,7 @@ Pose readExtrinsic(const Reader& r, const YAML::Node& n, const std::string& sens
   return fromXyzRpy({v[0], v[1], v[2], v[3], v[4], v[5]});
 }
 
-VehicleFootprint readVehicle(const Reader& r, const YAML::Node& n) {
+VehicleFootprint readVehicle(const YamlNodeReader& r, const YAML::Node& n) {
   r.requireMap(n, "vehicle");
   r.checkKeys(n, {"length", "width", "rear_overhang"}, "vehicle");
   VehicleFootprint f;
@@ -255,7 +131,7 @@ VehicleFootprint readVehicle(const Reader& r, const YAML::Node& n) {
   return f;
 }
 
-void readParameters(const Reader& r, const YAML::Node& n, Parameters& params,
+void readParameters(const YamlNodeReader& r, const YAML::Node& n, Parameters& params,
                     std::vector<std::string>& warnings) {
   r.requireMap(n, "parameters");
   const auto& specs = detail::parameterSpecs();
@@ -307,7 +183,7 @@ void readParameters(const Reader& r, const YAML::Node& n, Parameters& params,
 
 /// Two sensors on one port must be told apart by their source addresses: otherwise one driver would
 /// take both streams (and calibrate a mixture).
-void checkDistinctSources(const Reader& r, const YAML::Node& nodes, const std::vector<SensorConfig>& sensors) {
+void checkDistinctSources(const YamlNodeReader& r, const YAML::Node& nodes, const std::vector<SensorConfig>& sensors) {
   for (std::size_t j = 0; j < sensors.size(); ++j)
     for (std::size_t i = 0; i < j; ++i) {
       const SensorSource &a = sensors[i].source, &b = sensors[j].source;
@@ -324,7 +200,7 @@ void checkDistinctSources(const Reader& r, const YAML::Node& nodes, const std::v
     }
 }
 
-void checkConsistency(const Reader& r, const YAML::Node& root, const RigConfig& rig) {
+void checkConsistency(const YamlNodeReader& r, const YAML::Node& root, const RigConfig& rig) {
   const Parameters& p = rig.parameters;
   const YAML::Node params = root["parameters"] ? root["parameters"] : root;
   if (p.mapping_min_range >= p.mapping_max_range)
@@ -357,7 +233,7 @@ RigConfig loadRigConfigUnchecked(const std::filesystem::path& file) {
   if (const auto size = std::filesystem::file_size(file, ec); !ec && size > kMaxRigFileBytes)
     throw ConfigError({file}, "rig file is " + std::to_string(size) + " bytes; the limit is " +
                                   std::to_string(kMaxRigFileBytes));
-  const Reader r(file);
+  const YamlNodeReader r(file);
   YAML::Node root;
   try {
     root = YAML::LoadFile(file.string());
