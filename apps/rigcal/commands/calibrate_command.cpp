@@ -33,10 +33,7 @@
 #include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_worker.hpp"
 #include "rigcal/calib/outputs/calibration_outcome.hpp"
-#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
-#include "rigcal/calib/outputs/cloud_writers.hpp"
-#include "rigcal/calib/outputs/overview_png_writer.hpp"
-#include "rigcal/calib/outputs/report_json_writer.hpp"
+#include "rigcal/calib/outputs/calibration_outputs.hpp"
 #include "rigcal/calib/outputs/summary_table.hpp"
 #include "rigcal/config/config_error.hpp"
 #include "rigcal/config/rig_config.hpp"
@@ -260,15 +257,8 @@ void run(const CalibrateOptions& o) {
   for (const auto& sf : shortfalls) outcome.failure += (outcome.failure.empty() ? "" : "; ") + sf.message;
   if (outcome.failure.empty() && outcome.lidars.empty() && !rig.roles.calibration_lidars.empty())
     outcome.failure = "no calibration lidar got a dataset: no packets from " + rig.roles.calibration_lidars.front() + "?";
-  const auto t_out = Clock::now();
   try {
-    calib::writeCalibrationYaml(out / "calibration.yaml", outcome);
-    if (!outcome.datasets.empty()) {
-      calib::writeCalibrationClouds(out, outcome);
-      calib::writeOverviewPng(out / "overview.png", outcome);
-    }
-    outcome.stage_seconds.emplace_back("outputs", since(t_out));
-    calib::writeReportJson(out / "report.json", outcome);
+    calib::writeCalibrationOutputs(out, outcome);
   } catch (const std::exception& e) {
     throw CommandFailed(kExitFailure, e.what());
   }

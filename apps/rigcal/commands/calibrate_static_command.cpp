@@ -16,11 +16,8 @@
 #include "../rig_loading.hpp"
 #include "../static_capture.hpp"
 #include "../stop_signals.hpp"
-#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
-#include "rigcal/calib/outputs/cloud_writers.hpp"
-#include "rigcal/calib/outputs/overview_png_writer.hpp"
-#include "rigcal/calib/outputs/report_json_writer.hpp"
 #include "rigcal/calib/lidar_lidar/static_calibration.hpp"
+#include "rigcal/calib/outputs/calibration_outputs.hpp"
 #include "rigcal/calib/outputs/summary_table.hpp"
 
 namespace rigcal::app {
@@ -112,15 +109,8 @@ void runCalibrateStatic(const std::string& config, const PipelineCliOptions& inp
     std::cerr << "warning: " << w << "\n";
   }
 
-  const auto t_out = Clock::now();
   try {
-    calib::writeCalibrationYaml(out / "calibration.yaml", outcome);
-    if (!outcome.datasets.empty()) {
-      calib::writeCalibrationClouds(out, outcome);
-      calib::writeOverviewPng(out / "overview.png", outcome);
-    }
-    outcome.stage_seconds.emplace_back("outputs", since(t_out));
-    calib::writeReportJson(out / "report.json", outcome);
+    calib::writeCalibrationOutputs(out, outcome);
   } catch (const std::exception& e) {
     throw CommandFailed(kExitFailure, e.what());
   }
