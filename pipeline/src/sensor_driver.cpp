@@ -184,7 +184,10 @@ std::optional<double> SensorDriver::clockLagMs() const {
   return v[v.size() / 2];
 }
 
-const ForeignPackets& SensorDriver::foreignPackets() const { return tap_->foreign; }
+const ForeignPackets& SensorDriver::foreignPackets() const {
+  static const ForeignPackets kNone;  // a PointCloud2 sensor has no packets to recognise
+  return tap_ ? tap_->foreign : kNone;
+}
 
 std::string ForeignPackets::describe(const std::string& model, std::uint16_t port) const {
   return std::to_string(packets) + " packets of another model (" + drivers::toString(family) + ", " +

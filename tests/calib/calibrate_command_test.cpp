@@ -42,7 +42,7 @@ TEST(CalibrateCommand, NeitherPcapNorLiveIsAUsageError) {
   TempDir dir;
   const auto r = runRigcal({"calibrate", "--config", writeRig(dir).string()});
   EXPECT_EQ(r.exit_code, 2) << r.err;
-  EXPECT_NE(r.err.find("--pcap or --live"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--pcap or --bag or --live or --shm is required"), std::string::npos) << r.err;
 }
 
 // The pipeline options of `rigcal map` work here too: --cores pins, --stats writes the stage latencies.
