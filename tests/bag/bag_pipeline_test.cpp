@@ -113,8 +113,10 @@ std::vector<std::string> topicArgs(const char* form) {
   return args;
 }
 
-/// Frames at the end of a map run that depend on thread timing at the end of input.
-constexpr std::size_t kEndFrames = 3;
+/// Frames at the end of a map run that depend on thread timing at the end of input (1-2 measured on a quiet
+/// machine; more when a loaded machine lets the driver threads reach the end further apart: a busy
+/// `ctest -j 2` once saw more than 3).
+constexpr std::size_t kEndFrames = 8;
 
 std::vector<std::string> trajectoryRows(const fs::path& out) {
   std::istringstream in(readText(out / "trajectory.csv"));
