@@ -42,8 +42,8 @@ TEST(VoxelAccumulator, DropsNonFinitePointsAndRejectsABadLeaf) {
   EXPECT_EQ(acc.dropped(), 1u);
   ASSERT_EQ(acc.centroids().size(), 1u);
   EXPECT_NEAR(acc.centroids().points[0].x(), 0.025, 1e-12);
-  EXPECT_THROW(VoxelAccumulator(0.0), std::invalid_argument);
-  EXPECT_THROW(VoxelAccumulator(std::numeric_limits<double>::infinity()), std::invalid_argument);
+  EXPECT_THROW(VoxelAccumulator{0.0}, std::invalid_argument);
+  EXPECT_THROW(VoxelAccumulator{std::numeric_limits<double>::infinity()}, std::invalid_argument);
 }
 
 }  // namespace
