@@ -41,7 +41,13 @@ TEST(ViewServer, ServesItsPageAndAssets) {
   EXPECT_EQ(three.status, 200) << "libjs-three installed? (scripts/install-deps)";
   EXPECT_GT(three.body.size(), 100'000u);
   EXPECT_EQ(httpRequest(server.port(), "/OrbitControls.js").status, 200);
-  EXPECT_GE(server.stats().http_requests, 5u);
+  // HEAD: the page's status and type without its body; an unknown path is still 404.
+  const auto head = httpRequest(server.port(), "/", test::http::verb::head);
+  EXPECT_EQ(head.status, 200);
+  EXPECT_NE(head.content_type.find("text/html"), std::string::npos);
+  EXPECT_TRUE(head.body.empty());
+  EXPECT_EQ(httpRequest(server.port(), "/etc/passwd", test::http::verb::head).status, 404);
+  EXPECT_GE(server.stats().http_requests, 7u);
 }
 
 TEST(ViewServer, ReportIsServedOnceTheRunHasOne) {
