@@ -136,4 +136,14 @@ std::vector<std::string> Bag::warnings() const {
   return out;
 }
 
+std::string bagSourceWarning(const std::string& stream_error, const Bag& bag, std::uint64_t malformed,
+                             const std::string& last_malformed) {
+  std::string out = stream_error;
+  for (const auto& w : bag.warnings()) out += (out.empty() ? "" : "; ") + w;
+  if (!last_malformed.empty())
+    out += (out.empty() ? "" : "; ") + std::to_string(malformed) + " malformed messages dropped, last: " +
+           last_malformed;
+  return out;
+}
+
 }  // namespace rigcal::bag

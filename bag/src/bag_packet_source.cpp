@@ -81,12 +81,7 @@ std::optional<drivers::UdpPacket> BagPacketSource::next() {
 }
 
 std::string BagPacketSource::warning() const {
-  std::string out = stream_error_;
-  for (const auto& w : bag_.warnings()) out += (out.empty() ? "" : "; ") + w;
-  if (!last_malformed_.empty())
-    out += (out.empty() ? "" : "; ") + std::to_string(stats_.malformed) + " malformed messages dropped, last: " +
-           last_malformed_;
-  return out;
+  return bagSourceWarning(stream_error_, bag_, stats_.malformed, last_malformed_);
 }
 
 }  // namespace rigcal::bag

@@ -2,6 +2,7 @@
 // A ROS 2 bag: a rosbag2 folder (metadata.yaml naming one or several split files), a folder of storage
 // files, or a single .mcap / .db3 file. Messages of every file and topic come out merged in log-time
 // order, streamed: only each file's current chunk/row is in memory.
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -64,5 +65,10 @@ class Bag {
   std::priority_queue<Head, std::vector<Head>, std::greater<>> heads_;
   std::optional<std::size_t> last_file_;
 };
+
+/// The one-line warning of a source streaming a bag topic (packets or clouds): the stream's own error (a cut
+/// or corrupt chunk met while reading), the bag's warnings, and how many messages were malformed, the last named.
+std::string bagSourceWarning(const std::string& stream_error, const Bag& bag, std::uint64_t malformed,
+                             const std::string& last_malformed);
 
 }  // namespace rigcal::bag
