@@ -14,6 +14,7 @@
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
 #include "rigcal/bag/bag_error.hpp"
+#include "rigcal/bag/tf_tree.hpp"
 #include "rigcal/core/atomic_file.hpp"
 
 namespace rigcal::app {
@@ -48,21 +49,28 @@ std::string nameFromTopic(const std::string& topic) {
   return sanitize(parts.empty() ? topic : parts.back());
 }
 
-// T_base_frame along the tf edges, nullopt when `frame` is not connected to base_link.
-std::optional<Pose> toBase(const BagSummary& summary, const std::string& frame, std::string& path) {
-  std::map<std::string, std::pair<std::string, Pose>> parent_of;  // child -> (parent, T_parent_child)
-  for (const auto& [edge, t] : summary.tf) parent_of.try_emplace(edge.second, edge.first, t.first.T_parent_child);
-  Pose T = Pose::Identity();
-  std::string at = frame;
-  path = frame;
-  for (std::size_t hops = 0; at != kBaseFrame; ++hops) {
-    const auto it = parent_of.find(at);
-    if (it == parent_of.end() || hops > parent_of.size()) return std::nullopt;
-    T = it->second.second * T;
-    at = it->second.first;
-    path = at + " -> " + path;
+// The summary's tf edges as a tree: /tf_static first, so it wins over /tf for the same child (as
+// `initial_extrinsics: from_bag` reads the bag).
+bag::TfTree tfTree(const BagSummary& summary) {
+  bag::TfTree tree;
+  for (const bool statics : {true, false})
+    for (const auto& [edge, t] : summary.tf)
+      if ((t.second == "/tf_static") == statics) tree.add(t.first);
+  return tree;
+}
+
+// T_base_frame composed along the tree, nullopt when `frame` is not connected to base_link; `path` names
+// the frames walked ("base_link -> sensor_kit -> top").
+std::optional<Pose> toBase(const bag::TfTree& tree, const std::string& frame, std::string& path) {
+  std::vector<std::string> frames;
+  try {
+    const Pose T = tree.lookup(kBaseFrame, frame, &frames);
+    path.clear();
+    for (const auto& f : frames) path += (path.empty() ? "" : " -> ") + f;
+    return T;
+  } catch (const bag::BagError&) {
+    return std::nullopt;
   }
-  return T;
 }
 
 struct Lidar {
@@ -117,9 +125,10 @@ std::string starterRig(const BagSummary& summary) {
   y << "]\n";
   y << "  base_frame: " << kBaseFrame << "\n";
   y << "initial_extrinsics:\n";
+  const bag::TfTree tree = tfTree(summary);
   for (const auto& l : lidars) {
     std::string path;
-    const auto T = toBase(summary, l.frame, path);
+    const auto T = toBase(tree, l.frame, path);
     const XyzRpy v = toXyzRpy(T.value_or(Pose::Identity()));
     y << "  " << l.name << ": {x: " << number(v.x) << ", y: " << number(v.y) << ", z: " << number(v.z)
       << ", roll: " << number(v.roll) << ", pitch: " << number(v.pitch) << ", yaw: " << number(v.yaw) << "}";
