@@ -3,6 +3,8 @@
 // --deadline that would do.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 
 namespace rigcal::calib {
@@ -64,6 +66,43 @@ TEST(LidarLidarVerdict, DisagreeingFramesAreUnverified) {
   EXPECT_EQ(r.verdict, Verdict::kUnverified);
   EXPECT_NE(r.doubt.find("3 of 5 frames disagree"), std::string::npos) << r.doubt;
   EXPECT_NEAR(r.evidence.frame_spread_m, 0.4, 1e-9);
+}
+
+// Every frame "agrees" (within 5 cm) yet they scatter 2-3 cm about the result: four frames cannot put it within
+// the 1 cm goal (two standard errors 2.06 cm), and the deadline that cut the plan is named.
+TEST(LidarLidarVerdict, FramesScatteringBeyondTheGoalAreUnverified) {
+  auto r = resultWithFrames({1.0, 1.02, 0.98, 1.03});
+  r.deadline_reached = true;
+  judgeLidarLidar(r, 8, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_EQ(r.evidence.frames_agreeing, 4u);
+  EXPECT_NEAR(r.evidence.frame_uncertainty_m, 2.0 * std::sqrt(0.0017) / 4.0, 1e-9);
+  EXPECT_NE(r.doubt.find("its 4 frames scatter about it by ± 2.06 cm"), std::string::npos) << r.doubt;
+  EXPECT_NE(r.doubt.find("--deadline 20"), std::string::npos) << r.doubt;
+}
+
+// The same 1.5 cm scatter over sixteen frames narrows to ± 0.75 cm: within the goal, ok.
+TEST(LidarLidarVerdict, TheSameScatterOverMoreFramesIsOk) {
+  std::vector<double> xs;
+  for (int f = 0; f < 16; ++f) xs.push_back(f % 2 == 0 ? 1.015 : 0.985);
+  auto r = resultWithFrames(xs);
+  judgeLidarLidar(r, 16, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.doubt;
+  EXPECT_NEAR(r.evidence.frame_uncertainty_m, 0.0075, 1e-9);
+}
+
+// Rotation counts as translation does: frames 0.1-0.14° apart from a result make ± 0.1° over four frames.
+TEST(LidarLidarVerdict, FramesScatteringInRotationBeyondTheGoalAreUnverified) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0, 1.0});
+  r.deadline_reached = true;
+  const double yaws[] = {0.1, -0.12, 0.14, -0.1};
+  for (auto& run : r.runs) r.candidates[run.result].rotate(Eigen::AngleAxisd(deg2rad(yaws[run.frame]), Eigen::Vector3d::UnitZ()));
+  judgeLidarLidar(r, 4, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_GT(r.evidence.frame_uncertainty_deg, 0.05);
+  EXPECT_NE(r.doubt.find("more frames would narrow it"), std::string::npos) << r.doubt;
+  EXPECT_EQ(r.doubt.find("--deadline"), std::string::npos) << r.doubt;  // every frame was registered
+  EXPECT_NE(r.doubt.find("deg (two standard errors; the goal is 1.00 cm, 0.05 deg)"), std::string::npos) << r.doubt;
 }
 
 TEST(LidarLidarVerdict, LowInlierRatioIsUnverified) {

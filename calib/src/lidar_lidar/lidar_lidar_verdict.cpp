@@ -59,11 +59,19 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
   }
   e.registrators_agreeing.assign(agreeing.begin(), agreeing.end());
   e.frames_registered = frame_best.size();
+  double sum_sq_m = 0.0, sum_sq_deg = 0.0;
   for (const auto& [frame, run] : frame_best) {
     const Distance d = distance(r.candidates[run->result], r.T_mapping_calib);
     e.frame_spread_m = std::max(e.frame_spread_m, d.m);
     e.frame_spread_deg = std::max(e.frame_spread_deg, d.deg);
+    sum_sq_m += d.m * d.m;
+    sum_sq_deg += d.deg * d.deg;
     if (near(d)) ++e.frames_agreeing;
+  }
+  if (const double n = double(frame_best.size()); n >= 2) {
+    // rms / sqrt(n) = sqrt(sum / n²): the standard error of the frames' mean about the final result.
+    e.frame_uncertainty_m = 2.0 * std::sqrt(sum_sq_m) / n;
+    e.frame_uncertainty_deg = 2.0 * std::sqrt(sum_sq_deg) / n;
   }
 
   std::ostringstream why;
@@ -83,6 +91,17 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
   if (disagreeing > e.frames_agreeing)
     clause() << disagreeing << " of " << e.frames_registered << " frames disagree (spread " << 100.0 * e.frame_spread_m
              << " cm, " << e.frame_spread_deg << " deg)";
+  if (e.frame_uncertainty_m > opt.goal_m || e.frame_uncertainty_deg > opt.goal_deg) {
+    clause() << "its " << e.frames_registered << " frames scatter about it by ± " << 100.0 * e.frame_uncertainty_m
+             << " cm, " << std::setprecision(3) << e.frame_uncertainty_deg << std::setprecision(2)
+             << " deg (two standard errors; the goal is " << 100.0 * opt.goal_m << " cm, " << opt.goal_deg
+             << " deg)";
+    // More frames narrow it: the deadline's when it cut the plan short of the selected ones, else the budget's.
+    if (e.frames_registered < frames_selected)
+      short_of_evidence = true;
+    else
+      why << "; more frames would narrow it (lidar_calibration_max_frames, a longer drive)";
+  }
   if (agreeing.size() < opt.min_registrators) {
     clause() << "reached by " << agreeing.size() << " registrator(s) (needs " << opt.min_registrators << ")";
     short_of_evidence = true;

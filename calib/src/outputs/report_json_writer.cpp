@@ -79,6 +79,8 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
                    {"frames_agreeing", e.frames_agreeing},
                    {"frame_spread_m", e.frame_spread_m},
                    {"frame_spread_deg", e.frame_spread_deg},
+                   {"frame_uncertainty_m", e.frame_uncertainty_m},
+                   {"frame_uncertainty_deg", e.frame_uncertainty_deg},
                    {"registrators_agreeing", e.registrators_agreeing},
                    {"inlier_ratio", e.inlier_ratio},
                    {"clock_offset_ms", e.clock_offset_ms}};

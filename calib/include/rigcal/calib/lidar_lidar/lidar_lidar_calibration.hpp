@@ -55,6 +55,10 @@ struct LidarLidarEvidence {
   std::size_t frames_agreeing = 0;   // of those, frames whose own best result lies near the final one
   double frame_spread_m = 0.0;       // largest distance of a frame's own best result from the final one
   double frame_spread_deg = 0.0;
+  // How far the final result may be off, judged by how its frames scatter about it: two standard errors
+  // (2 · rms / sqrt(n)) over the n frames' own best results; 0 with fewer than two frames.
+  double frame_uncertainty_m = 0.0;
+  double frame_uncertainty_deg = 0.0;
   std::vector<std::string> registrators_agreeing;  // registrators with a result near the final one
   double inlier_ratio = 0.0;         // of the final score
   double suggested_deadline_s = 0.0; // > 0: the calibration_deadline_s (--deadline) that would confirm it
