@@ -32,7 +32,7 @@ inline bool samePose(const Pose& a, const Pose& b) {
 
 struct Frame {
   std::size_t index = 0;  // in the dataset
-  PointCloud source;
+  PointCloud source;        // covariances only once a GICP ran on the frame (ensureSourceCovariances)
   PointCloud score_source;  // every stride-th point: what the all-frames score looks at
   std::shared_ptr<const Target> target;
 };
@@ -71,6 +71,10 @@ class Calibrator {
   /// chain NDT → GICP → ICP coarse → fine → ultra-fine that brings the largest improvement per second.
   /// Exhaustive pass: each registrator from every candidate so far not yet tried with it on this frame.
   void frameEnsemble(std::size_t k, bool exhaustive);
+
+  /// Frame k's source covariances for GICP, estimated once, when a GICP is first run on it (most frames cut
+  /// by the deadline never need them); false when it does not fit in the time left or the deadline cut it.
+  bool ensureSourceCovariances(std::size_t k);
 
   /// One cheap registration of frame k alone (ICP fine from the best so far): where that frame puts the
   /// lidar, so that the verdict can check that the frames agree before the deadline cuts the full ensembles.

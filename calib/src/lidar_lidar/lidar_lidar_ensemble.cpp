@@ -9,6 +9,7 @@
 #include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_source.hpp"
 #include "rigcal/calib/lidar_lidar/ensemble_plan.hpp"
+#include "rigcal/registration/covariance.hpp"
 
 namespace rigcal::calib::detail {
 
@@ -29,6 +30,7 @@ void Calibrator::frameEnsemble(std::size_t k, bool exhaustive) {
     for (const std::size_t start : starts) {
       if (!tried_.insert({f.index, int(r), start}).second) continue;  // this run was done already
       if (stopped()) return;
+      if (r == Registrator::kGicp && !ensureSourceCovariances(k)) continue;  // the ICPs may still fit
       RegistratorRun run;
       run.frame = int(f.index);
       run.registrator = toString(r);
@@ -63,6 +65,21 @@ void Calibrator::frameEnsemble(std::size_t k, bool exhaustive) {
       if (!samePose(out_.candidates[frame_best], best_)) consider(out_.candidates[frame_best], winner);
     }
   }
+}
+
+bool Calibrator::ensureSourceCovariances(std::size_t k) {
+  PointCloud& source = frames_[k].source;
+  if (source.hasCovariances() || source.size() < 3) return true;
+  // Its temporary kd-tree cannot be cut: start only when the estimate (a target's cost per point, which
+  // also covers a tree and covariances) fits.
+  if (!fits(deadline_, seconds_per_point_ * double(source.size()))) return false;
+  registration::CovarianceOptions cov;
+  cov.num_threads = opt_.num_threads;
+  cov.deadline = deadline_;
+  registration::estimateCovariances(source, cov);
+  if (!stopped()) return true;
+  source.clearAttributes();  // cut short: incomplete, never used
+  return false;
 }
 
 void Calibrator::confirmOnFrame(std::size_t k) {
