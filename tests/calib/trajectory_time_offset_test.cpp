@@ -68,7 +68,7 @@ TEST_F(TrajectoryClock, ALateClockIsEstimatedAndNamed) {
   const auto& c = r.trajectory_clock;
   ASSERT_EQ(c.status, TrajectoryClockEstimate::Status::kEstimated) << c.note;
   EXPECT_NEAR(c.offset_ms, 35.0, std::max(5.0, 2.0 * c.uncertainty_ms));
-  EXPECT_LT(c.uncertainty_ms, 10.0);
+  EXPECT_LT(c.uncertainty_ms, 20.0);
   EXPECT_EQ(r.verdict, Verdict::kUnverified);
   EXPECT_NE(r.doubt.find("clock: " + d.calibration_sensor), std::string::npos) << r.doubt;
   EXPECT_NE(r.doubt.find("time_offset_ns"), std::string::npos) << r.doubt;
@@ -84,7 +84,7 @@ TEST_F(TrajectoryClock, AgreeingClocksAreNotDoubted) {
   const auto& c = r.trajectory_clock;
   ASSERT_NE(c.status, TrajectoryClockEstimate::Status::kNotRun);
   if (c.status == TrajectoryClockEstimate::Status::kEstimated) {
-    EXPECT_LT(std::abs(c.offset_ms), 10.0 + 2.0 * c.uncertainty_ms);
+    EXPECT_LT(std::abs(c.offset_ms), std::max(10.0, 2.0 * c.uncertainty_ms));
   }
   EXPECT_EQ(r.doubt.find("clock: "), std::string::npos) << r.doubt;
 }
@@ -99,7 +99,7 @@ TEST(TrajectoryClockParabola, VertexOfUnevenlySpacedSamples) {
   EXPECT_LE(flat.second, 0.0) << "no curvature: no minimum";
 }
 
-TEST(TrajectoryClockVerdict, OnlyAnEstimateBeyondTheLimitAndItsUncertaintyDoubts) {
+TEST(TrajectoryClockVerdict, OnlyASignificantEstimateBeyondTheLimitDoubts) {
   const auto judged = [](TrajectoryClockEstimate::Status status, double offset_ms, double sigma_ms) {
     LidarLidarResult r;
     r.ok = true;
@@ -120,8 +120,10 @@ TEST(TrajectoryClockVerdict, OnlyAnEstimateBeyondTheLimitAndItsUncertaintyDoubts
       << late.doubt;
   EXPECT_NE(late.doubt.find("time_offset_ns: 40000000"), std::string::npos) << "adds to the applied 5 ms\n"
                                                                             << late.doubt;
-  EXPECT_EQ(judged(S::kEstimated, -14.0, 3.0).verdict, Verdict::kOk) << "within 10 ms + 2σ";
-  EXPECT_EQ(judged(S::kEstimated, -17.0, 3.0).verdict, Verdict::kUnverified);
+  EXPECT_EQ(judged(S::kEstimated, -9.0, 1.0).verdict, Verdict::kOk) << "within the limit";
+  EXPECT_EQ(judged(S::kEstimated, -14.0, 3.0).verdict, Verdict::kUnverified) << "beyond it, and significant";
+  EXPECT_EQ(judged(S::kEstimated, 25.0, 15.0).verdict, Verdict::kOk) << "beyond it, but within 2σ of 0";
+  EXPECT_EQ(judged(S::kEstimated, 38.7, 15.5).verdict, Verdict::kUnverified) << "the shm case measured";
   EXPECT_EQ(judged(S::kUnobservable, 35.0, 30.0).verdict, Verdict::kOk) << "no estimate judges nothing";
   EXPECT_EQ(judged(S::kDeadline, 0.0, 0.0).verdict, Verdict::kOk);
 }

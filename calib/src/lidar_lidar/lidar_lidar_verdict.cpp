@@ -125,7 +125,7 @@ void doubtClockOffset(LidarLidarResult& r, double offset_ms, double limit_ms, do
 void doubtTrajectoryClockOffset(LidarLidarResult& r, double limit_ms) {
   const TrajectoryClockEstimate& c = r.trajectory_clock;
   if (c.status != TrajectoryClockEstimate::Status::kEstimated || r.verdict == Verdict::kFailed) return;
-  if (std::abs(c.offset_ms) <= limit_ms + 2.0 * c.uncertainty_ms) return;
+  if (std::abs(c.offset_ms) <= limit_ms || std::abs(c.offset_ms) <= 2.0 * c.uncertainty_ms) return;
   std::ostringstream why;
   why.setf(std::ios::fixed);
   why.precision(1);
