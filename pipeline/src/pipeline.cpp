@@ -77,6 +77,7 @@ PipelineProgress Pipeline::progress() const {
   p.mapping_done = m.mapping_done.load();
   p.mapping_sensor = m.sensors[0];
   p.mapping_lost_packets = m.mapping_lost_packets.load();
+  p.mapping_malformed_packets = m.mapping_malformed_packets.load();
   for (std::size_t i = 0; i < m.lanes.size(); ++i) {
     const LaneCounters& c = *m.lanes[i];
     LidarProgress l;
@@ -88,6 +89,7 @@ PipelineProgress Pipeline::progress() const {
     l.budget = m.params.lidar_calibration_max_frames;
     l.handed_over = c.handed_over.load();
     l.lost_packets = c.lost_packets.load();
+    l.malformed_packets = c.malformed_packets.load();
     p.lidars.push_back(l);
   }
   return p;

@@ -85,6 +85,7 @@ struct StageRecord {
 struct LaneCounters {
   std::atomic<std::uint64_t> scans{0}, candidates{0}, accepted{0}, selected{0};
   std::atomic<std::uint64_t> lost_packets{0};  // Scan::missing_packets summed: drivers and rings alike
+  std::atomic<std::uint64_t> malformed_packets{0};  // its in-process driver's count so far (rings carry none)
   std::atomic<bool> handed_over{false};
 };
 
@@ -121,7 +122,7 @@ struct Pipeline::Impl {
   // Progress.
   std::atomic<std::uint64_t> skipped{0};
   std::atomic<std::uint64_t> mapping_scans{0}, registered{0}, stored{0}, keyframes{0}, stopped{0}, lost{0},
-      unknown_sensor_scans{0}, mapping_lost_packets{0};
+      unknown_sensor_scans{0}, mapping_lost_packets{0}, mapping_malformed_packets{0};
   std::atomic<bool> mapping_done{false};
   std::vector<std::unique_ptr<LaneCounters>> lanes;
 

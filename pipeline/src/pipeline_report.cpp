@@ -36,9 +36,12 @@ std::string PipelineProgress::line() const {
   if (mapping_done) o << " (map full)";
   // Packets lost show as they happen, not only in the final report.
   if (mapping_lost_packets > 0) o << " | " << mapping_sensor << " lost " << mapping_lost_packets << " pkts";
+  if (mapping_malformed_packets > 0)
+    o << (mapping_lost_packets > 0 ? ", " : " | " + mapping_sensor + ' ') << mapping_malformed_packets << " malformed";
   for (const auto& l : lidars) {
     o << " | " << l.sensor << ' ' << l.selected << '/' << l.budget << " (cand " << l.candidates << ')';
     if (l.lost_packets > 0) o << " (lost " << l.lost_packets << " pkts)";
+    if (l.malformed_packets > 0) o << " (" << l.malformed_packets << " malformed)";
     if (l.handed_over) o << " done";
   }
   return o.str();

@@ -62,14 +62,19 @@ void Pipeline::Impl::setUpSources() {
     const bool throttle = isRecording(options.input) && !realtime;
     for (std::size_t s = 0; s < sensors.size(); ++s) {
       const int sensor = int(s);
+      const std::size_t d = drivers.size();  // the vector is complete before any driver thread starts
       if (const auto t = options.bag_topics.find(sensors[s]); t != options.bag_topics.end()) in.topic = t->second;
       else if (const auto any = options.bag_topics.find(""); any != options.bag_topics.end()) in.topic = any->second;
       else in.topic.clear();
       drivers.push_back(std::make_unique<SensorDriver>(
-          rig.sensor(sensors[s]), in, source_stop, [this, sensor, throttle](Scan&& scan) {
+          rig.sensor(sensors[s]), in, source_stop, [this, sensor, d, throttle](Scan&& scan) {
             const std::int64_t t0 = steadyNs();
             if (throttle && sensor > 0) waitForMappingLead(scan.stamp_ns);
             const TimeNs stamp = scan.stamp_ns;
+            // Malformed packets as they happen (on the driver's own thread, which owns its counters).
+            const std::uint64_t malformed = drivers[d]->assemblerStats().malformed + drivers[d]->sourceStats().malformed;
+            (sensor == 0 ? mapping_malformed_packets : lanes[std::size_t(sensor - 1)]->malformed_packets)
+                .store(malformed, std::memory_order_relaxed);
             ingest(std::move(scan), sensor, t0);
             if (throttle && sensor == 0) mappingIngested(stamp, false);
           }));

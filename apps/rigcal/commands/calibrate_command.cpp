@@ -89,7 +89,9 @@ void run(const CalibrateOptions& o) {
   StopSignals signals;
   // Every calibration lidar shares one calibration_deadline_s, whenever its dataset comes (budget full
   // during the drive, or end of input).
-  calib::LidarLidarWorker worker(rig.parameters, rig.roles.calibration_lidars.size());
+  calib::LidarLidarOptions lidar_lidar;
+  lidar_lidar.trajectory_clock = true;  // the clock check that needs no capture time (live, shm)
+  calib::LidarLidarWorker worker(rig.parameters, rig.roles.calibration_lidars.size(), lidar_lidar);
   std::unique_ptr<pipeline::Pipeline> pipe;
   try {
     pipe = std::make_unique<pipeline::Pipeline>(rig, po, [&](std::shared_ptr<const pipeline::CalibrationDataset> d) {
@@ -248,6 +250,7 @@ void run(const CalibrateOptions& o) {
             {*in.clock_lag_ms, in.clock_lag_sigma_ms, in.clock_lag_sweeps});
         calib::doubtClockOffset(r, offset.offset_ms, kClockOffsetLimitMs, offset.uncertainty_ms);
       }
+    calib::doubtTrajectoryClockOffset(r, kClockOffsetLimitMs);
   }
   const auto shortfalls = pipe->shortfalls();
   for (const auto& sf : shortfalls) outcome.input_summary.emplace_back(sf.sensor + "_missing", sf.message);

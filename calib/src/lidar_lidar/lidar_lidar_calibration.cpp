@@ -1,6 +1,7 @@
 #include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <exception>
 #include <iomanip>
 #include <sstream>
@@ -15,6 +16,27 @@ using detail::Clock;
 using detail::finitePose;
 using detail::since;
 
+namespace {
+
+TrajectoryClockEstimate trajectoryClock(const pipeline::CalibrationDataset& dataset, const detail::Calibrator& calibrator,
+                                        const LidarLidarResult& result, const registration::Deadline& deadline,
+                                        const LidarLidarOptions& options) {
+  std::vector<TrajectoryClockFrame> frames;
+  for (const auto& f : calibrator.frames())
+    frames.push_back({&f.source, f.target.get(), dataset.frames[f.index].pairing.scan_stamp_ns});
+  try {
+    return estimateTrajectoryClockOffset(frames, dataset.trajectory, result.T_mapping_calib, deadline,
+                                         options.trajectory_clock_options);
+  } catch (const std::exception& e) {  // a trajectory it cannot interpolate: no estimate, the calibration stands
+    TrajectoryClockEstimate none;
+    none.status = TrajectoryClockEstimate::Status::kUnobservable;
+    none.note = e.what();
+    return none;
+  }
+}
+
+}  // namespace
+
 LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
                                      const registration::Deadline& deadline, const LidarLidarOptions& options) {
   const auto t0 = Clock::now();
@@ -26,9 +48,21 @@ LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset
   if (deadline.when() != registration::Deadline::Clock::time_point::max())
     out.deadline_share_s = std::max(0.0, secondsLeft(deadline));
   out.failure = validateDataset(dataset, params);
+  // The trajectory clock estimate's time comes off the end of the calibration's (its exhaustive ensemble).
+  registration::Deadline calibration_deadline = deadline;
+  if (options.trajectory_clock && deadline.when() != registration::Deadline::Clock::time_point::max()) {
+    const double reserve =
+        std::min(options.trajectory_clock_max_s, options.trajectory_clock_share * std::max(0.0, secondsLeft(deadline)));
+    calibration_deadline = registration::Deadline::at(
+        deadline.when() - std::chrono::duration_cast<registration::Deadline::Clock::duration>(
+                              std::chrono::duration<double>(reserve)),
+        deadline.token());
+  }
   if (out.failure.empty()) {
     try {
-      detail::Calibrator(dataset, params, deadline, options, out).run();
+      detail::Calibrator calibrator(dataset, params, calibration_deadline, options, out);
+      calibrator.run();
+      if (options.trajectory_clock && out.ok) out.trajectory_clock = trajectoryClock(dataset, calibrator, out, deadline, options);
     } catch (const std::exception& e) {  // a bad dataset the validation did not foresee: a clear failure
       out.ok = false;
       out.T_mapping_calib = dataset.T_mapping_calib_guess;  // validated finite

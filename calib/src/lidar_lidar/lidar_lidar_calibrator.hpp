@@ -45,6 +45,9 @@ class Calibrator {
 
   void run();
 
+  /// The frames registered (sources re-deskewed with the result), for the trajectory clock estimate.
+  [[nodiscard]] const std::vector<Frame>& frames() const { return frames_; }
+
  private:
   bool stopped();
 

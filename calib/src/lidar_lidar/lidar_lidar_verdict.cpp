@@ -141,4 +141,21 @@ void doubtClockOffset(LidarLidarResult& r, double offset_ms, double limit_ms, do
   r.verdict = Verdict::kUnverified;
 }
 
+void doubtTrajectoryClockOffset(LidarLidarResult& r, double limit_ms) {
+  const TrajectoryClockEstimate& c = r.trajectory_clock;
+  if (c.status != TrajectoryClockEstimate::Status::kEstimated || r.verdict == Verdict::kFailed) return;
+  if (std::abs(c.offset_ms) <= limit_ms || std::abs(c.offset_ms) <= 2.0 * c.uncertainty_ms) return;
+  std::ostringstream why;
+  why.setf(std::ios::fixed);
+  why.precision(1);
+  const double total_ms = r.evidence.time_offset_applied_ms + c.offset_ms;
+  why << "clock: " << r.calibration_sensor << "'s stamps are " << std::showpos << c.offset_ms << std::noshowpos
+      << " ms (± " << c.uncertainty_ms << ") off " << r.mapping_sensor
+      << "'s trajectory (registration over trial offsets; more than " << limit_ms
+      << " ms pairs it with the wrong mapping pose): fix the sensor's time sync, or set its time_offset_ns: "
+      << std::llround(total_ms * 1e6) << " in the rig";
+  r.doubt = r.verdict == Verdict::kUnverified ? why.str() + "; " + r.doubt : why.str();
+  r.verdict = Verdict::kUnverified;
+}
+
 }  // namespace rigcal::calib

@@ -89,6 +89,19 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
     j["evidence"]["time_offset_applied_ms"] = e.time_offset_applied_ms;
   }
   if (e.suggested_deadline_s > 0) j["evidence"]["suggested_deadline_s"] = e.suggested_deadline_s;
+  const TrajectoryClockEstimate& tc = r->trajectory_clock;
+  if (tc.status != TrajectoryClockEstimate::Status::kNotRun) {
+    j["evidence"]["trajectory_clock_status"] = toString(tc.status);
+    j["evidence"]["trajectory_clock_note"] = tc.note;
+    j["evidence"]["trajectory_clock_seconds"] = tc.seconds;
+    if (tc.status == TrajectoryClockEstimate::Status::kEstimated) {
+      j["evidence"]["trajectory_clock_offset_ms"] = tc.offset_ms;
+      j["evidence"]["trajectory_clock_uncertainty_ms"] = tc.uncertainty_ms;
+    }
+    json profile = json::array();
+    for (const auto& [ms, cost] : tc.profile) profile.push_back({ms, cost});
+    j["evidence"]["trajectory_clock_profile"] = profile;  // (trial offset ms, cost m² per point)
+  }
   j["deadline_reached"] = r->deadline_reached;  // this lidar ran out of time (its result is the best so far)
   if (r->deadline_share_s >= 0) j["deadline_share_s"] = r->deadline_share_s;
   j["result"] = xyzRpy(r->T_mapping_calib);

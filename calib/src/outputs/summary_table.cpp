@@ -77,6 +77,21 @@ std::string summaryTable(const CalibrationOutcome& o) {
     }
     out << "\n";
   }
+  for (const auto& r : o.lidars) {
+    // The residual clock offset against the mapping trajectory (no capture time needed), or why there is none.
+    const TrajectoryClockEstimate& c = r.trajectory_clock;
+    if (c.status == TrajectoryClockEstimate::Status::kNotRun) continue;
+    char line[320];
+    if (c.status == TrajectoryClockEstimate::Status::kEstimated)
+      std::snprintf(line, sizeof line, "  %s: clock %+.1f ms (± %.1f) against %s's trajectory\n",
+                    r.calibration_sensor.c_str(), c.offset_ms, c.uncertainty_ms, r.mapping_sensor.c_str());
+    else {
+      out << "  " << r.calibration_sensor << ": clock against " << r.mapping_sensor << "'s trajectory: "
+          << toString(c.status) << " (" << c.note << ")\n";
+      continue;
+    }
+    out << line;
+  }
   for (const auto& w : o.warnings) out << "  warning: " << w << "\n";
   if (o.base && !o.base->ok) out << "  " << o.mapping_sensor << " (base): " << o.base->failure << "\n";
   if (o.base && o.base->ok) {

@@ -71,6 +71,9 @@ struct LidarProgress {
   int budget = 0;                // lidar_calibration_max_frames
   bool handed_over = false;      // its dataset went to the callback
   std::uint64_t lost_packets = 0;  // the packets its scans say were lost (any input: pcap, live, rings)
+  /// Packets its driver dropped as malformed so far (pcap, bag, live; a shared-memory ring does not carry
+  /// them: its driver process reports them on exit).
+  std::uint64_t malformed_packets = 0;
 };
 
 struct PipelineProgress {
@@ -84,6 +87,7 @@ struct PipelineProgress {
   bool mapping_done = false;  // mapping_max_frames reached: the mapper stopped by itself
   std::string mapping_sensor;
   std::uint64_t mapping_lost_packets = 0;  // as LidarProgress::lost_packets, for the mapping lidar
+  std::uint64_t mapping_malformed_packets = 0;  // as LidarProgress::malformed_packets
   std::vector<LidarProgress> lidars;
   /// Mean budget fill over the calibration lidars, 0..1.
   [[nodiscard]] double budgetFill() const;

@@ -10,6 +10,7 @@
 
 #include "rigcal/calib/lidar_lidar/augmented_target.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar/trajectory_time_offset.hpp"
 #include "rigcal/config/parameters.hpp"
 #include "rigcal/core/pose.hpp"
 #include "rigcal/pipeline/calibration_dataset.hpp"
@@ -25,6 +26,13 @@ struct LidarLidarOptions {
   /// After the quick passes and the final refinement, spend the time left on upstream's exhaustive
   /// ensemble (every registrator from every candidate on every frame). Off: finish as soon as refined.
   bool exhaustive = true;
+  /// After the calibration, the residual clock offset against the mapping trajectory from the frames just
+  /// registered (trajectory_time_offset.hpp). Under a deadline it gets `trajectory_clock_share` of the time
+  /// left when the calibration starts (at most `trajectory_clock_max_s`), taken from the ensemble's end.
+  bool trajectory_clock = false;
+  double trajectory_clock_share = 0.15;
+  double trajectory_clock_max_s = 2.0;
+  TrajectoryClockOptions trajectory_clock_options;
 };
 
 /// One registration the ensemble ran (for report.json).
@@ -88,6 +96,7 @@ struct LidarLidarResult {
   Verdict verdict = Verdict::kFailed;  // kOk needs ok and the evidence; kUnverified: ok but not confirmed
   std::string doubt;                   // one line when verdict is kUnverified: why, and what is missing
   LidarLidarEvidence evidence;
+  TrajectoryClockEstimate trajectory_clock;  // kNotRun unless LidarLidarOptions::trajectory_clock
 };
 
 /// Empty when `dataset` can be calibrated, else one line naming the field that is wrong.

@@ -35,4 +35,11 @@ void judgeLidarLidar(LidarLidarResult& result, std::size_t frames_selected, doub
 /// ok (the sensor and the offset named, with the rig's time_offset_ns that would correct it).
 void doubtClockOffset(LidarLidarResult& result, double offset_ms, double limit_ms, double uncertainty_ms = 0.0);
 
+/// The same judgement from result.trajectory_clock (the offset against the mapping trajectory, which needs
+/// no capture time: live and shared-memory input): an estimate beyond `limit_ms` that is significant
+/// (|δ| > 2σ) makes the result unverified, naming the sensor, δ ± σ and the time_offset_ns that would fix
+/// it. Not |δ| > limit + 2σ: a lidar 35 ms late over shm measured +38.7 ± 15.5 ms and its 3.6 cm error
+/// would have passed as ok. No estimate (unobservable, deadline, not run): nothing is judged.
+void doubtTrajectoryClockOffset(LidarLidarResult& result, double limit_ms);
+
 }  // namespace rigcal::calib
