@@ -53,8 +53,10 @@ void simulateWithBags(const std::string& scenario, const fs::path& sim_dir, cons
       std::regex("/sensing/lidar/(\\w+)/points"), "/$1/points");
 }
 
-/// `rigcal calibrate` of a preset from the pcap and both MCAPs; every bag result against the pcap's.
-void calibrateThreeWays(const std::string& scenario) {
+/// `rigcal calibrate` of a preset from the pcap and both MCAPs; every bag result against the pcap's. With
+/// `mapping_only`, the calibration lidars' results are held only to an honest verdict (exit 0 only within
+/// the goal), not to agreement: for a preset whose calibration lidars do not converge from the pcap either.
+void calibrateThreeWays(const std::string& scenario, bool mapping_only = false) {
   TempDir dir;
   const fs::path sim_dir = dir / "sim";
   ASSERT_NO_FATAL_FAILURE(simulateWithBags(scenario, sim_dir));
@@ -70,6 +72,11 @@ void calibrateThreeWays(const std::string& scenario) {
                                      (sim_dir / "rig.yaml").string()});
     std::printf("%s from %s (exit %d), against the truth:\n%s", scenario.c_str(), out, r.exit_code,
                 compared.out.c_str());
+    if (mapping_only && r.exit_code == 0) {
+      const auto goal = runRigcal({"compare", "--truth", (sim_dir / "truth.yaml").string(), "--result",
+                                   (dir / out / "calibration.yaml").string(), "--max-cm", "1", "--max-deg", "0.05"});
+      EXPECT_EQ(goal.exit_code, 0) << scenario << " " << out << ": called ok off the goal\n" << goal.out;
+    }
     return YAML::LoadFile((dir / out / "calibration.yaml").string())["T_base_sensor"];
   };
   const YAML::Node pcap = calibrate(sim_dir / "rig.yaml", {"--pcap", (sim_dir / "recording.pcap").string()}, "pcap");
@@ -79,6 +86,7 @@ void calibrateThreeWays(const std::string& scenario) {
   const YAML::Node points =
       calibrate(sim_dir / "rig_from_bag.yaml", {"--bag", (sim_dir / "recording_points.mcap").string()}, "points");
   for (const auto& s : rig.sensors) {
+    if (mapping_only && s.name != rig.roles.mapping_lidar) continue;
     ASSERT_TRUE(pcap[s.name]) << scenario << ": no " << s.name << " in the pcap's calibration.yaml";
     for (const auto& [form, result] : {std::pair{"packets", packets}, std::pair{"points", points}}) {
       ASSERT_TRUE(result[s.name]) << scenario << " " << form << ": no " << s.name;
@@ -110,9 +118,13 @@ TEST(SimMcapPresetsLong, YardCorners) {
   calibrateThreeWays("yard-corners");
 }
 
+// The sideways lidars of yard-side are not calibrated reliably from any input (lidar_lidar_mounts_test:
+// "not solved", held to an honest verdict). Measured at load 10-15: side_left 37.7 cm off the truth from
+// the pcap, 53.3 cm from the packet MCAP, 36.4 cm from the PointCloud2 MCAP, all exit 6 (unverified);
+// side_right 0.6-0.7 cm, 0.05-0.11°. The mapping lidar agrees (0.000 / 0.007 cm).
 TEST(SimMcapPresetsLong, YardSide) {
   if (!longTests()) GTEST_SKIP() << "long test: RIGCAL_LONG_TESTS=1 (Release)";
-  calibrateThreeWays("yard-side");
+  calibrateThreeWays("yard-side", /*mapping_only=*/true);
 }
 
 /// The pose preset through calibrate-pose from each input; the bags' poses come from their /odom.
