@@ -7,6 +7,11 @@
 //    once, then streamed message by message through bag::Bag; peak_rss_MB is the process's high-water
 //    mark while streaming (VmHWM after resetting it through /proc/self/clear_refs), rss_before_MB the
 //    resident size before.
+// Measured (taskset -c 1, 10 repetitions, CPU-time medians, the pcap in the same run; 2 cores shared at
+// load 3-15, five runs): pcap 22.0-24.9 ms; MCAP uncompressed 1.02-1.05x, zstd 1.14-1.21x (before
+// bag::PageBuffer and the kept zstd context: 1.42-1.45x and 1.51-1.55x). perf on the zstd run: libzstd 9.1 % and the
+// chunks' CRC-32 (zlib) 2.5 % of the cycles, the rest as the pcap path: inflating is what remains.
+// stream_1GB: a 1.19 GB zstd MCAP streamed with a peak RSS of 14.5 MB (12.3 MB before).
 #include <fstream>
 #include <string>
 

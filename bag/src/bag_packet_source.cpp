@@ -18,6 +18,7 @@ std::uint16_t defaultPort(PacketMessageType type, bool difop) {
 }  // namespace
 
 BagPacketSource::BagPacketSource(const std::filesystem::path& bag, const std::string& topic) : bag_(bag) {
+  if (bag_.topics().empty()) throw BagError(bag.string() + ": empty bag (no topics)");  // as lidar_topic.cpp says it
   if (topic.empty()) {
     std::vector<std::size_t> candidates;
     for (std::size_t i = 0; i < bag_.topics().size(); ++i)

@@ -11,10 +11,16 @@
 
 namespace rigcal::bag::mcap {
 
+struct ChunkDecompressor::Contexts {
+  std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> zstd{nullptr, &ZSTD_freeDCtx};
+  std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> lz4{nullptr, &LZ4F_freeDecompressionContext};
+};
+
 namespace {
 
-void inflateZstd(std::span<const std::uint8_t> in, std::vector<std::uint8_t>& out, std::string_view what) {
-  const std::size_t n = ZSTD_decompress(out.data(), out.size(), in.data(), in.size());
+void inflateZstd(ZSTD_DCtx& ctx, std::span<const std::uint8_t> in, std::span<std::uint8_t> out,
+                 std::string_view what) {
+  const std::size_t n = ZSTD_decompressDCtx(&ctx, out.data(), out.size(), in.data(), in.size());
   if (ZSTD_isError(n))
     throw BagError(std::string(what) + ": zstd chunk does not decompress: " + ZSTD_getErrorName(n));
   if (n != out.size())
@@ -22,15 +28,13 @@ void inflateZstd(std::span<const std::uint8_t> in, std::vector<std::uint8_t>& ou
                    std::to_string(out.size()));
 }
 
-void inflateLz4(std::span<const std::uint8_t> in, std::vector<std::uint8_t>& out, std::string_view what) {
-  LZ4F_dctx* raw = nullptr;
-  if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION)))
-    throw BagError(std::string(what) + ": cannot create an lz4 context");
-  const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> ctx(raw, &LZ4F_freeDecompressionContext);
+void inflateLz4(LZ4F_dctx& ctx, std::span<const std::uint8_t> in, std::span<std::uint8_t> out,
+                std::string_view what) {
+  LZ4F_resetDecompressionContext(&ctx);  // a previous chunk may have failed mid-frame
   std::size_t in_pos = 0, out_pos = 0;
   while (true) {
     std::size_t in_size = in.size() - in_pos, out_size = out.size() - out_pos;
-    const std::size_t hint = LZ4F_decompress(ctx.get(), out.data() + out_pos, &out_size, in.data() + in_pos,
+    const std::size_t hint = LZ4F_decompress(&ctx, out.data() + out_pos, &out_size, in.data() + in_pos,
                                              &in_size, nullptr);
     if (LZ4F_isError(hint))
       throw BagError(std::string(what) + ": lz4 chunk does not decompress: " + LZ4F_getErrorName(hint));
@@ -64,8 +68,12 @@ void checkDeclaredSize(const ChunkRecord& chunk, std::string_view what) {
 
 }  // namespace
 
-std::span<const std::uint8_t> inflateChunk(const ChunkRecord& chunk, std::vector<std::uint8_t>& buffer,
-                                           std::string_view what) {
+ChunkDecompressor::ChunkDecompressor() : contexts_(std::make_unique<Contexts>()) {}
+
+ChunkDecompressor::~ChunkDecompressor() = default;
+
+std::span<const std::uint8_t> ChunkDecompressor::inflate(const ChunkRecord& chunk, PageBuffer& buffer,
+                                                         std::string_view what) {
   std::span<const std::uint8_t> records;
   if (chunk.compression.empty()) {
     records = chunk.records;
@@ -76,12 +84,21 @@ std::span<const std::uint8_t> inflateChunk(const ChunkRecord& chunk, std::vector
       throw BagError(std::string(what) + ": chunk declares " + std::to_string(chunk.uncompressed_size) +
                      " uncompressed bytes, more than the " + std::to_string(kMaxChunkBytes) + " accepted");
     checkDeclaredSize(chunk, what);  // before allocating what a corrupt header claims
-    buffer.resize(std::size_t(chunk.uncompressed_size));
-    if (chunk.compression == "zstd")
-      inflateZstd(chunk.records, buffer, what);
-    else
-      inflateLz4(chunk.records, buffer, what);
-    records = buffer;
+    const auto out = buffer.resize(std::size_t(chunk.uncompressed_size));
+    if (chunk.compression == "zstd") {
+      if (!contexts_->zstd) contexts_->zstd.reset(ZSTD_createDCtx());
+      if (!contexts_->zstd) throw BagError(std::string(what) + ": cannot create a zstd context");
+      inflateZstd(*contexts_->zstd, chunk.records, out, what);
+    } else {
+      if (!contexts_->lz4) {
+        LZ4F_dctx* raw = nullptr;
+        if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION)))
+          throw BagError(std::string(what) + ": cannot create an lz4 context");
+        contexts_->lz4.reset(raw);
+      }
+      inflateLz4(*contexts_->lz4, chunk.records, out, what);
+    }
+    records = out;
   }
   if (records.size() != chunk.uncompressed_size)
     throw BagError(std::string(what) + ": chunk holds " + std::to_string(records.size()) + " bytes, declares " +

@@ -6,7 +6,6 @@
 
 #include "rigcal/bag/bag_error.hpp"
 #include "rigcal/bag/byte_cursor.hpp"
-#include "rigcal/bag/chunk_decompressor.hpp"
 #include "rigcal/bag/crc32.hpp"
 
 namespace rigcal::bag {
@@ -149,7 +148,7 @@ void McapFile::scanLinearly() {
   std::uint32_t data_crc = crc32Update(0, mcap::kMagic);
   std::uint32_t data_crc_after_header = 0;
   bool in_data = true, footer_seen = false;
-  std::vector<std::uint8_t> body, inflated;
+  PageBuffer body_buffer, inflated;
   std::vector<Entry> entries;
   while (true) {
     std::array<std::uint8_t, mcap::kRecordHeaderSize> head{};
@@ -172,7 +171,7 @@ void McapFile::scanLinearly() {
     }
     if (h.length > mcap::kMaxChunkBytes)
       throw BagError(where(pos) + ": record of " + std::to_string(h.length) + " bytes is larger than accepted");
-    body.resize(std::size_t(h.length));
+    const auto body = body_buffer.resize(std::size_t(h.length));
     file_.readAt(pos + head.size(), body);
     const std::string what = where(pos);
     if (h.opcode == op(Opcode::kDataEnd)) {
@@ -199,7 +198,7 @@ void McapFile::scanLinearly() {
       const std::string chunk_what = path_.string() + ": chunk at offset " + std::to_string(pos);
       const auto chunk = mcap::parseChunk(body, chunk_what);
       entries.clear();
-      indexRecords(mcap::inflateChunk(chunk, inflated, chunk_what), chunk_what, &entries);
+      indexRecords(decompressor_.inflate(chunk, inflated, chunk_what), chunk_what, &entries);
       if (!entries.empty()) {
         const auto [lo, hi] = std::minmax_element(entries.begin(), entries.end(),
                                                   [](const Entry& a, const Entry& b) { return a.log_time < b.log_time; });
@@ -215,20 +214,28 @@ void McapFile::scanLinearly() {
 }
 
 void McapFile::load(const Ref& ref, std::size_t order) {
-  auto chunk = std::make_unique<Loaded>();
+  std::unique_ptr<Loaded> chunk;
+  if (spare_.empty()) {
+    chunk = std::make_unique<Loaded>();
+  } else {
+    chunk = std::move(spare_.back());
+    spare_.pop_back();
+    chunk->entries.clear();
+    chunk->next = 0;
+  }
   chunk->order = order;
-  chunk->record.resize(std::size_t(ref.length));
   const std::string what = path_.string() + ": chunk at offset " + std::to_string(ref.offset);
-  if (ref.length < mcap::kRecordHeaderSize || file_.readAt(ref.offset, chunk->record) != ref.length)
+  const auto record = chunk->record.resize(std::size_t(ref.length));
+  if (ref.length < mcap::kRecordHeaderSize || file_.readAt(ref.offset, record) != ref.length)
     throw BagError(what + ": record of " + std::to_string(ref.length) + " bytes cut short by the end of the file");
-  const auto h = parseHeader(std::span<const std::uint8_t, mcap::kRecordHeaderSize>(chunk->record.data(), 9));
-  const auto body = std::span<const std::uint8_t>(chunk->record).subspan(mcap::kRecordHeaderSize);
+  const auto h = parseHeader(std::span<const std::uint8_t, mcap::kRecordHeaderSize>(record.data(), 9));
+  const auto body = std::span<const std::uint8_t>(record).subspan(mcap::kRecordHeaderSize);
   if (h.length != body.size())
     throw BagError(what + ": record length " + std::to_string(h.length) + " disagrees with the index (" +
                    std::to_string(body.size()) + ")");
   if (h.opcode == op(Opcode::kChunk)) {
     const auto parsed = mcap::parseChunk(body, what);
-    chunk->records = mcap::inflateChunk(parsed, chunk->inflated, what);
+    chunk->records = decompressor_.inflate(parsed, chunk->inflated, what);
     indexRecords(chunk->records, what, &chunk->entries);
     std::stable_sort(chunk->entries.begin(), chunk->entries.end(),
                      [](const Entry& a, const Entry& b) { return a.log_time < b.log_time; });
@@ -240,7 +247,10 @@ void McapFile::load(const Ref& ref, std::size_t order) {
   } else {
     throw BagError(what + ": expected a chunk, found opcode " + std::to_string(h.opcode));
   }
-  if (chunk->entries.empty()) return;
+  if (chunk->entries.empty()) {
+    spare_.push_back(std::move(chunk));
+    return;
+  }
   heap_.push({chunk->entries.front().log_time, order, chunk.get()});
   loaded_.push_back(std::move(chunk));
   peak_loaded_ = std::max(peak_loaded_, loaded_.size());
@@ -248,7 +258,10 @@ void McapFile::load(const Ref& ref, std::size_t order) {
 
 std::optional<StoredMessage> McapFile::next() {
   if (retired_) {
-    std::erase_if(loaded_, [&](const std::unique_ptr<Loaded>& c) { return c.get() == retired_; });
+    const auto it =
+        std::find_if(loaded_.begin(), loaded_.end(), [&](const std::unique_ptr<Loaded>& c) { return c.get() == retired_; });
+    spare_.push_back(std::move(*it));
+    loaded_.erase(it);
     retired_ = nullptr;
   }
   while (next_ref_ < refs_.size() && (heap_.empty() || refs_[next_ref_].start_time <= heap_.top().log_time)) {

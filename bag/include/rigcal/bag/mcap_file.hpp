@@ -12,7 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "rigcal/bag/chunk_decompressor.hpp"
 #include "rigcal/bag/mcap_records.hpp"
+#include "rigcal/bag/page_buffer.hpp"
 #include "rigcal/bag/read_only_file.hpp"
 #include "rigcal/bag/storage_reader.hpp"
 
@@ -45,8 +47,9 @@ class McapFile final : public StorageReader {
     std::uint32_t offset = 0, length = 0;
     std::size_t topic = 0;
   };
+  // Exhausted chunks go back to spare_ and their buffers are reused by the next load.
   struct Loaded {
-    std::vector<std::uint8_t> record, inflated;
+    PageBuffer record, inflated;
     std::vector<Entry> entries;
     std::size_t next = 0;
     std::span<const std::uint8_t> records;
@@ -79,7 +82,8 @@ class McapFile final : public StorageReader {
   std::size_t next_ref_ = 0;
   bool indexed_ = false;
   std::string warning_;
-  std::vector<std::unique_ptr<Loaded>> loaded_;
+  mcap::ChunkDecompressor decompressor_;
+  std::vector<std::unique_ptr<Loaded>> loaded_, spare_;
   std::priority_queue<HeapItem, std::vector<HeapItem>, std::greater<>> heap_;
   Loaded* retired_ = nullptr;
   std::size_t peak_loaded_ = 0;  // exhausted chunk whose bytes the last message still points into
