@@ -8,6 +8,7 @@
 
 #include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
+#include "rigcal/calib/lidar_lidar/shared_ground_refinement.hpp"
 #include "rigcal/registration/icp.hpp"
 #include "rigcal/registration/target.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
@@ -63,13 +64,13 @@ std::string fixed(double v, int digits) {
 
 // The static verdict: the lidar-lidar rules with the accumulated cloud as the one frame there is, then the
 // scene's own doubts (directions it leaves free, a second basin as good as the best).
-void judgeStatic(LidarLidarResult& r, const CloudPairResult& pair, double deadline_s, double min_uniqueness) {
+void judgeStatic(LidarLidarResult& r, const CloudPairResult& pair, const std::vector<std::string>& weak,
+                 double deadline_s, double min_uniqueness) {
   VerdictOptions vo;
   vo.min_frames = 1;  // one accumulated cloud: the registrators' agreement and the inliers are the evidence
   judgeLidarLidar(r, 1, deadline_s, vo);
   if (r.verdict == Verdict::kFailed) return;
   std::vector<std::string> doubts;
-  const auto weak = pair.information.weakDirections();
   if (!weak.empty()) {
     std::string names;
     for (const auto& w : weak) names += (names.empty() ? "" : ", ") + w;
@@ -88,6 +89,22 @@ void judgeStatic(LidarLidarResult& r, const CloudPairResult& pair, double deadli
   for (const auto& d : doubts) all += (all.empty() ? "" : "; ") + d;
   r.doubt = r.verdict == Verdict::kUnverified && !r.doubt.empty() ? all + "; " + r.doubt : all;
   r.verdict = Verdict::kUnverified;
+}
+
+// The pair's weak directions, less those the shared floor fixed: a tilt (a rotation axis along the floor)
+// and the height (a translation across it). What the floor leaves free (yaw, along the floor) stays weak.
+std::vector<std::string> weakDirections(const RegistrationInformation& info, const SharedGroundRefinement* floor) {
+  std::vector<std::string> weak;
+  const auto fixedByFloor = [&](const DirectionInformation& d, bool rotation) {
+    if (floor == nullptr || !floor->applied) return false;
+    const double along_normal = std::abs(d.direction.dot(floor->floor_normal));
+    return rotation ? along_normal < 0.5 : along_normal > 0.87;  // within 30° of the floor / of its normal
+  };
+  for (const auto& d : info.translation)
+    if (d.weak && !fixedByFloor(d, false)) weak.push_back(d.name);
+  for (const auto& d : info.rotation)
+    if (d.weak && !fixedByFloor(d, true)) weak.push_back(d.name);
+  return weak;
 }
 
 }  // namespace
@@ -203,6 +220,15 @@ StaticCalibration calibrateStatic(const StaticCapture& capture, const config::Ri
     const double left = std::max(0.0, opt.deadline_s - since(t_ll));
     po.deadline_s = left / double(capture.calibration.size() - k);
     CloudPairResult pair = registerCloudPair(*target, *source, rig.parameters, po);
+    // The ensemble's cost leaves a tilted lidar's tilt weak where the two see different floor: both
+    // floors, fitted in each lidar's frame, fix tilt and height; the structure on them yaw and x/y.
+    std::optional<SharedGroundRefinement> floor;
+    if (pair.ok) {
+      const Eigen::Vector3d up = T_base_mapping.linear().transpose() * Eigen::Vector3d::UnitZ();
+      floor = refineWithSharedGround(*target, *source, pair.T_target_source, up);
+      if (floor->applied) pair.T_target_source = floor->T_target_source;
+    }
+    const auto weak = weakDirections(pair.information, floor ? &*floor : nullptr);
 
     LidarLidarResult r = pair.ensemble;
     r.mapping_sensor = rig.roles.mapping_lidar;
@@ -215,15 +241,27 @@ StaticCalibration calibrateStatic(const StaticCapture& capture, const config::Ri
     r.initial_score = pair.guess_score;
     r.final_score = pair.final_score;
     r.seconds = pair.seconds;
-    judgeStatic(r, pair, opt.deadline_s, opt.min_uniqueness);
+    judgeStatic(r, pair, weak, opt.deadline_s, opt.min_uniqueness);
 
     o.datasets.push_back(staticDataset(rig.roles.mapping_lidar, sensor, target, source, T_base_mapping, guess));
     o.lidars.push_back(std::move(r));
     o.input_summary.emplace_back(sensor + "_sweeps", std::to_string(scans.size()));
     o.input_summary.emplace_back(sensor + "_overlap", fixed(pair.source_overlap, 3));
-    std::string weak;
-    for (const auto& w : pair.information.weakDirections()) weak += (weak.empty() ? "" : " ") + w;
-    o.input_summary.emplace_back(sensor + "_weak_directions", weak.empty() ? "none" : weak);
+    std::string weak_names;
+    for (const auto& w : weak) weak_names += (weak_names.empty() ? "" : " ") + w;
+    o.input_summary.emplace_back(sensor + "_weak_directions", weak_names.empty() ? "none" : weak_names);
+    if (floor) {
+      o.input_summary.emplace_back(
+          sensor + "_shared_floor",
+          floor->applied ? "tilt " + fixed(floor->tilt_correction_deg, 3) + " deg, height " +
+                               fixed(100 * floor->height_correction_m, 2) + " cm, yaw " +
+                               fixed(floor->yaw_correction_deg, 3) + " deg, along the floor " +
+                               fixed(100 * floor->planar_correction_m, 2) + " cm (" +
+                               std::to_string(floor->source_floor_points) + " / " +
+                               std::to_string(floor->target_floor_points) + " floor points)"
+                         : "not applied: " + floor->note);
+      o.stage_seconds.emplace_back(sensor + "_shared_floor", floor->seconds);
+    }
     if (pair.global && pair.global->second_score)
       o.input_summary.emplace_back(sensor + "_second_basin_ratio",
                                    fixed(*pair.global->second_score / std::max(pair.global->best_score, 1e-12), 2));
