@@ -58,7 +58,9 @@ void runCalibrateStatic(const std::string& config, const PipelineCliOptions& inp
   so.deadline_s = rig.parameters.calibration_deadline_s;
   calib::StaticCalibration sc;
   std::string shortfall;
-  if (cap.capture.mapping.empty()) {
+  if (!cap.settled && !cap.never_still.empty() && !interrupted) {
+    shortfall = "static: " + cap.never_still;
+  } else if (cap.capture.mapping.empty()) {
     shortfall = "no complete sweep of the mapping lidar " + rig.roles.mapping_lidar + " in the input";
   } else {
     sc = calib::calibrateStatic(cap.capture, rig, so);
@@ -83,7 +85,8 @@ void runCalibrateStatic(const std::string& config, const PipelineCliOptions& inp
       {"captured_s", fixed(cap.capture.capture_s, 2)},
       {"capture_complete", cap.complete ? "yes" : "no (the input ended first)"},
       {"mapping_sweeps", std::to_string(cap.capture.mapping.size())},
-      {"still", sc.stillness.still ? "yes" : "no"},
+      {"waited_for_stillness_s", fixed(cap.waited_s, 2)},
+      {"still", cap.settled && sc.stillness.still ? "yes" : "no"},
       {"max_motion_m", fixed(sc.stillness.largest.metres, 4)},
       {"max_motion_deg", fixed(sc.stillness.largest.degrees, 3)},
       {"interrupted", interrupted ? "yes" : "no"}};

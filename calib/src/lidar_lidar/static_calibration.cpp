@@ -9,6 +9,7 @@
 #include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 #include "rigcal/calib/lidar_lidar/shared_ground_refinement.hpp"
+#include "rigcal/calib/lidar_lidar/stillness_watch.hpp"
 #include "rigcal/registration/icp.hpp"
 #include "rigcal/registration/target.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
@@ -20,9 +21,6 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Voxel of the stillness check: fine enough that a 1 cm shift moves the ICP minimum, coarse enough that a
-// 64-beam sweep registers in a few ms.
-constexpr double kStillnessVoxel = 0.2;
 // The accumulated clouds: 2 cm centroids average the sweeps' range noise without blurring any edge.
 constexpr double kAccumulationVoxel = 0.02;
 // Metres the base-lidar crop box grows by around the vehicle's footprint (a 64-beam roof lidar at 2 m
@@ -118,31 +116,18 @@ StillnessCheck checkStillness(const ScanList& scans, const config::Parameters& p
     c.seconds = since(t0);
     return c;
   }
-  registration::TargetOptions to;
-  to.normals_and_covariances = true;
-  to.num_threads = 2;
-  const registration::Target first(
-      registration::voxelDownsample(registration::fromScan(*scans.front()), kStillnessVoxel), to);
-  registration::IcpParams p;
-  p.method = registration::IcpMethod::kPointToPlane;
-  p.max_correspondence_distance = 1.0;  // a moving vehicle's sweeps are still matched a metre apart
-  p.max_iterations = 50;
-  p.coarse_to_fine = true;
-  p.check_degeneracy = false;
-  p.num_threads = 2;
+  const SweepRegistrar first(*scans.front());
   Pose previous = Pose::Identity();  // each sweep starts from the previous one's pose: motion is smooth
   for (std::size_t k = 1; k < scans.size(); ++k) {
     if (scans[k] == nullptr) continue;
-    const auto source = registration::voxelDownsample(registration::fromScan(*scans[k]), kStillnessVoxel);
-    if (source.size() < 50 || first.size() < 50) continue;
-    const auto r = registration::alignIcp(first, source, previous, p);
-    if (!r.T_target_source.matrix().allFinite()) continue;
-    previous = r.T_target_source;
+    const auto T = first.motion(*scans[k], previous);
+    if (!T) continue;
+    previous = *T;
     StillnessSample s;
     s.scan = k;
     s.t_s = toSeconds(scans[k]->stamp_ns - scans.front()->stamp_ns);
-    s.metres = r.T_target_source.translation().norm();
-    s.degrees = rad2deg(rotationAngleBetween(r.T_target_source, Pose::Identity()));
+    s.metres = T->translation().norm();
+    s.degrees = rad2deg(rotationAngleBetween(*T, Pose::Identity()));
     c.samples.push_back(s);
     if (s.metres > c.largest.metres || (s.metres == c.largest.metres && s.degrees > c.largest.degrees)) c.largest = s;
     if (!c.first_moved && (s.metres > c.limit_m || s.degrees > c.limit_deg)) c.first_moved = s;
