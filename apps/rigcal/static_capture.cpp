@@ -150,16 +150,25 @@ StaticCaptureResult captureStatic(const config::RigConfig& rig, const pipeline::
     for (auto& t : threads) t.join();
   } else {
     pipeline::DriverInput in;
-    if (options.input == pipeline::InputKind::kPcap) {
-      in.pcap = options.pcap;
-      in.rate = options.rate;
-    }
-    for (std::size_t k = 0; k < sensors.size(); ++k)
+    if (options.input == pipeline::InputKind::kPcap) in.pcap = options.pcap;
+    if (options.input == pipeline::InputKind::kBag) in.bag = options.bag;
+    if (pipeline::isRecording(options.input)) in.rate = options.rate;
+    for (const auto& [name, topic] : options.bag_topics)
+      if (name.empty() ? sensors.size() != 1 : std::find(sensors.begin(), sensors.end(), name) == sensors.end())
+        throw std::runtime_error(name.empty() ? "a bag topic without a sensor name (" + topic +
+                                                    ") needs a one-sensor rig: give SENSOR=TOPIC"
+                                              : "a bag topic for '" + name + "', which is not a lidar of the rig");
+    for (std::size_t k = 0; k < sensors.size(); ++k) {
+      // --topic SENSOR=TOPIC, else the sensor's source.topic, else the bag's only lidar topic.
+      if (const auto t = options.bag_topics.find(sensors[k]); t != options.bag_topics.end()) in.topic = t->second;
+      else if (const auto any = options.bag_topics.find(""); any != options.bag_topics.end()) in.topic = any->second;
+      else in.topic.clear();
       drivers.push_back(std::make_unique<pipeline::SensorDriver>(
           rig.sensor(sensors[k]), in, collect.stop, [&collect, k](Scan&& scan) {
             collect.pollOuterStop();
             collect.add(k, std::move(scan));
           }));
+    }
     for (std::size_t k = 0; k < drivers.size(); ++k)
       threads.emplace_back([&, k] {
         drivers[k]->run([&collect] { collect.pollOuterStop(); });

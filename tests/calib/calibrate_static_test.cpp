@@ -6,6 +6,7 @@
 //  - the degenerate bay (a flat floor and one wall): unverified, the free direction named, exit 6;
 //  - the vehicle driving off during the capture: refused (exit 5) saying when and how much it moved;
 //  - the vehicle rolling in first: the capture waits until it has stood for 0.5 s; never still: exit 5;
+//  - the bay from its MCAP (`--bag`, `--topic`) as from its pcap;
 //  - live: `calibrate --static --live` on loopback ports fed by `rigcal replay --rate 1 --clock now`.
 // Bounds: see kMaxCm / kMaxDeg below (measured numbers there).
 #include <gtest/gtest.h>
@@ -202,6 +203,39 @@ TEST(CalibrateStatic, VehicleNeverStillIsRefused) {
   const auto report = readJson(dir / "out" / "report.json");
   EXPECT_EQ(report["status"], "failed");
   EXPECT_EQ(report["input"]["still"], "no");
+}
+
+// The same parked bay from the simulator's packet MCAP (`rigcal sim --format both`, --topic per lidar) as
+// from its pcap: the same sweeps, so the same calibration (measured identical to the µm). --deadline 3:
+// the shared-floor refinement settles both on the same minimum (about 3 CPU-s each).
+TEST(CalibrateStatic, FromTheBaysMcapAsFromItsPcap) {
+  if (kSanitized) GTEST_SKIP() << "seconds of registration in Release: minutes under sanitizers";
+  TempDir dir;
+  const auto sim = runRigcal({"sim", "--scenario", "calibration-bay", "--format", "both", "--out", (dir / "sim").string()});
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  double seconds = 0.0;
+  const auto from_pcap = calibrateStatic(dir / "sim", dir / "pcap", &seconds, {"--deadline", "3"});
+  ASSERT_NO_FATAL_FAILURE(expectOkOrNamedDoubt(from_pcap, dir / "pcap"));
+  std::vector<std::string> args{"calibrate", "--static", "--config", (dir / "sim" / "rig.yaml").string(), "--bag",
+                                (dir / "sim" / "recording.mcap").string(), "--out", (dir / "bag").string(),
+                                "--deadline", "3"};
+  for (const char* lidar : {"top", "side_left", "side_right"})
+    args.insert(args.end(), {"--topic", std::string(lidar) + "=/" + lidar + "/packets"});
+  const auto from_bag = runRigcal(args);
+  std::printf("%s%s", from_bag.out.c_str(), from_bag.err.c_str());
+  ASSERT_NO_FATAL_FAILURE(expectOkOrNamedDoubt(from_bag, dir / "bag"));
+  const auto pcap_report = readJson(dir / "pcap" / "report.json");
+  const auto bag_report = readJson(dir / "bag" / "report.json");
+  EXPECT_EQ(bag_report["input"]["source"], (dir / "sim" / "recording.mcap").string());
+  EXPECT_EQ(bag_report["input"]["mapping_sweeps"], pcap_report["input"]["mapping_sweeps"]);
+  for (const char* lidar : {"top", "side_left", "side_right"}) {
+    const auto& a = pcap_report["T_base_sensor"][lidar];
+    const auto& b = bag_report["T_base_sensor"][lidar];
+    for (const char* k : {"x", "y", "z"}) EXPECT_NEAR(a[k].get<double>(), b[k].get<double>(), 1e-3) << lidar << " " << k;
+    for (const char* k : {"roll", "pitch", "yaw"})
+      EXPECT_NEAR(a[k].get<double>(), b[k].get<double>(), 1e-4) << lidar << " " << k;  // rad: 0.006°
+  }
+  expectCloseToTruth(dir / "sim", dir / "bag");
 }
 
 // True once a UDP socket is bound to `port` (/proc/net/udp lists local ports in hex).
