@@ -18,6 +18,10 @@
 namespace rigcal::calib {
 namespace {
 
+// m: a plane with this many points further below it is not the floor (noise and a 2.5 cm fit band stay
+// well inside)
+constexpr double kUnderFloor = 0.10;
+
 struct Floor {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, along the expected up
   double d = 0.0;                                     // normal·p + d = 0
@@ -55,23 +59,15 @@ bool refitPlane(const std::vector<Eigen::Vector3d>& pts, double band, Floor& f) 
   return true;
 }
 
-// The floor under a sensor, in its own frame: the largest near-horizontal plane well below it.
-std::optional<Floor> fitFloor(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up,
-                              const SharedGroundSettings& s, std::string* why) {
-  std::vector<Eigen::Vector3d> below;
-  for (const auto& p : points)
-    if (up.dot(p) < -s.min_below_sensor && p.norm() < s.max_floor_range) below.push_back(p);
-  if (below.size() < s.min_floor_points) {
-    *why = std::to_string(below.size()) + " points below the sensor (need " + std::to_string(s.min_floor_points) + ")";
-    return std::nullopt;
-  }
-  // RANSAC on at most 20000 of them (evenly strided): the refits below use every point.
+// RANSAC (on at most 20000 of the points, evenly strided) then least-squares refits on all of them.
+std::optional<Floor> largestPlane(const std::vector<Eigen::Vector3d>& below, const Eigen::Vector3d& up,
+                                  const SharedGroundSettings& s, std::string* why) {
   std::vector<Eigen::Vector3d> sample;
   const std::size_t stride = std::max<std::size_t>(1, below.size() / 20000);
   for (std::size_t k = 0; k < below.size(); k += stride) sample.push_back(below[k]);
   GroundPlaneSettings gs;
   gs.max_inlier_distance = s.ransac_inlier_distance;
-  gs.max_iterations = 500;
+  gs.max_iterations = 1000;
   gs.min_plane_points = int(s.min_floor_points / stride);
   gs.min_plane_points_percentage = 10.0;
   gs.max_cos_distance = 1.0 - std::cos(deg2rad(s.max_up_deviation_deg));
@@ -91,6 +87,32 @@ std::optional<Floor> fitFloor(const std::vector<Eigen::Vector3d>& points, const 
   return f;
 }
 
+// The floor under a sensor, in its own frame: the lowest large near-horizontal plane well below it.
+std::optional<Floor> fitFloor(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up,
+                              const SharedGroundSettings& s, std::string* why) {
+  std::vector<Eigen::Vector3d> below;  // candidates, then what lies under the last plane found
+  for (const auto& p : points)
+    if (up.dot(p) < -s.min_below_sensor && p.norm() < s.max_floor_range) below.push_back(p);
+  if (below.size() < s.min_floor_points) {
+    *why = std::to_string(below.size()) + " points below the sensor (need " + std::to_string(s.min_floor_points) + ")";
+    return std::nullopt;
+  }
+  // The largest near-horizontal plane may be crate tops or a shelf: while enough points lie well below
+  // the plane found, it is not the floor, and the search goes on among those points.
+  for (int round = 0; round < 4; ++round) {
+    auto f = largestPlane(below, up, s, why);
+    if (!f) return std::nullopt;
+    std::vector<Eigen::Vector3d> under;
+    for (const auto& p : below)
+      if (f->normal.dot(p) + f->d < -kUnderFloor) under.push_back(p);
+    if (under.size() < std::max<std::size_t>(s.min_floor_points, f->points / 10)) return f;
+    below = std::move(under);
+  }
+  *why = "every plane found had another one under it";
+  return std::nullopt;
+}
+
+
 std::string fixed(double v, int digits) {
   std::ostringstream o;
   o << std::fixed << std::setprecision(digits) << v;
@@ -99,9 +121,46 @@ std::string fixed(double v, int digits) {
 
 }  // namespace
 
-SharedGroundRefinement refineWithSharedGround(const Scan& target_scan, const Scan& source_scan,
-                                              const Pose& T_in, const Eigen::Vector3d& up_target,
-                                              const SharedGroundSettings& s) {
+struct SharedGroundReference::Impl {
+  std::optional<Floor> floor;
+  std::string note;  // why there is no reference
+  std::optional<registration::Target> structure;
+};
+
+SharedGroundReference::SharedGroundReference(const Scan& target_scan, const Eigen::Vector3d& up_target,
+                                             const SharedGroundSettings& s)
+    : impl_(std::make_unique<Impl>()), settings_(s) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto target = finitePoints(target_scan);
+  std::string why;
+  impl_->floor = fitFloor(target, up_target.normalized(), s, &why);
+  if (!impl_->floor) {
+    impl_->note = "no floor in the target cloud (" + why + ")";
+  } else {
+    const Floor& f = *impl_->floor;
+    registration::PointCloud structure;
+    for (const auto& p : target)
+      if (f.normal.dot(p) + f.d > s.refit_inlier_distance * 2) structure.add(p.x(), p.y(), p.z());
+    structure = registration::voxelDownsample(structure, s.structure_voxel);
+    if (structure.size() < 100) {
+      impl_->note = "too little structure above the target's floor (" + std::to_string(structure.size()) + " voxels)";
+      impl_->floor.reset();
+    } else {
+      registration::TargetOptions to;
+      to.normals_and_covariances = true;
+      to.num_threads = 2;
+      impl_->structure.emplace(std::move(structure), to);
+    }
+  }
+  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+SharedGroundReference::~SharedGroundReference() = default;
+
+bool SharedGroundReference::ok() const { return impl_->floor.has_value(); }
+
+SharedGroundRefinement SharedGroundReference::refine(const Scan& source_scan, const Pose& T_in) const {
+  const SharedGroundSettings& s = settings_;
   const auto t0 = std::chrono::steady_clock::now();
   SharedGroundRefinement out;
   out.T_target_source = T_in;
@@ -110,48 +169,40 @@ SharedGroundRefinement refineWithSharedGround(const Scan& target_scan, const Sca
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
   };
-  const auto target = finitePoints(target_scan), source = finitePoints(source_scan);
+  if (!impl_->floor) return finish(impl_->note);
+  const Floor& ft = *impl_->floor;
+  const auto source = finitePoints(source_scan);
   const Eigen::Matrix3d R_in = T_in.linear();
   std::string why;
-  const auto ft = fitFloor(target, up_target.normalized(), s, &why);
-  if (!ft) return finish("no floor in the target cloud (" + why + ")");
-  const auto fs = fitFloor(source, R_in.transpose() * up_target.normalized(), s, &why);
+  const auto fs = fitFloor(source, R_in.transpose() * ft.normal, s, &why);
   if (!fs) return finish("no floor in the source cloud (" + why + ")");
-  out.target_floor_points = ft->points;
+  out.target_floor_points = ft.points;
   out.source_floor_points = fs->points;
-
   // 1. Tilt and height: the source's floor onto the target's (rotating about the source's origin).
-  const Eigen::Vector3d n = ft->normal;
+  const Eigen::Vector3d n = ft.normal;
   out.floor_normal = n;
   Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(R_in * fs->normal, n).toRotationMatrix() * R_in;
-  Eigen::Vector3d t = T_in.translation() + (fs->d - ft->d - n.dot(T_in.translation())) * n;
+  Eigen::Vector3d t = T_in.translation() + (fs->d - ft.d - n.dot(T_in.translation())) * n;
 
   // 2. Yaw about the floor normal and translation along the floor: ICP over what stands on the floor.
   Eigen::Vector3d e1 = Eigen::Vector3d::UnitX() - n.x() * n;
   if (e1.norm() < 1e-3) e1 = Eigen::Vector3d::UnitY() - n.y() * n;
   e1.normalize();
   const Eigen::Vector3d e2 = n.cross(e1);
-  registration::PointCloud target_structure, source_structure;
-  for (const auto& p : target)
-    if (n.dot(p) + ft->d > s.refit_inlier_distance * 2) target_structure.add(p.x(), p.y(), p.z());
+  registration::PointCloud source_structure;
   for (const auto& p : source)
     if (fs->normal.dot(p) + fs->d > s.off_floor_height) source_structure.add(p.x(), p.y(), p.z());
-  target_structure = registration::voxelDownsample(target_structure, s.structure_voxel);
   source_structure = registration::voxelDownsample(source_structure, s.structure_voxel);
-  if (target_structure.size() < 100 || source_structure.size() < 100)
-    return finish("too little structure above the floor (" + std::to_string(target_structure.size()) + " target, " +
-                  std::to_string(source_structure.size()) + " source voxels)");
-  registration::TargetOptions to;
-  to.normals_and_covariances = true;
-  to.num_threads = 2;
-  const registration::Target tgt(std::move(target_structure), to);
+  if (source_structure.size() < 100)
+    return finish("too little structure above the source's floor (" + std::to_string(source_structure.size()) +
+                  " voxels)");
+  const registration::Target& tgt = *impl_->structure;
   const auto& tp = tgt.cloud().points;
   const auto& tn = tgt.cloud().normals;
   constexpr double kHuber = 0.02;  // m: residuals beyond this weigh less (edges, what one lidar sees only)
   std::size_t matches = 0;
-  int iterations = 0;
   for (double dist = s.max_correspondence; dist >= s.min_correspondence * 0.999; dist /= 2) {
-    for (int it = 0; it < s.max_iterations / 3; ++it, ++iterations) {
+    for (int it = 0; it < s.max_iterations / 3; ++it) {
       Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
       Eigen::Vector3d g = Eigen::Vector3d::Zero();
       matches = 0;

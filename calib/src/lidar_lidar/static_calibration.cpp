@@ -163,6 +163,7 @@ Scan accumulateSweeps(const ScanList& scans, double voxel) {
 
 StaticCalibration calibrateStatic(const StaticCapture& capture, const config::RigConfig& rig,
                                   const StaticCalibrationOptions& opt) {
+  const auto t_plan = Clock::now();
   StaticCalibration out;
   CalibrationOutcome& o = out.outcome;
   o.rig_name = rig.name;
@@ -186,9 +187,15 @@ StaticCalibration calibrateStatic(const StaticCapture& capture, const config::Ri
   auto target = std::make_shared<const Scan>(accumulateSweeps(capture.mapping, kAccumulationVoxel));
   o.map_cloud = target;
   o.stage_seconds.emplace_back("accumulate", since(t_acc));
+  // The floor and the structure on it under the mapping lidar, for every calibration lidar's refinement.
+  const SharedGroundReference floor_reference(*target,
+                                              T_base_mapping.linear().transpose() * Eigen::Vector3d::UnitZ());
+  o.stage_seconds.emplace_back("shared_floor_reference", floor_reference.buildSeconds());
 
-  // Each calibration lidar in turn, each with an equal share of what is left of the deadline.
+  // Each calibration lidar in turn, each with an equal share of what is left of the deadline less the
+  // share kept for what comes after the ensembles (polish, information, floor refinement, base-lidar).
   const auto t_ll = Clock::now();
+  const double ensembles_s = (1.0 - opt.later_share) * opt.deadline_s;
   for (std::size_t k = 0; k < capture.calibration.size(); ++k) {
     const auto& [sensor, scans] = capture.calibration[k];
     const Pose guess = T_base_mapping.inverse() * rig.initial_T_base_sensor.at(sensor);
@@ -202,15 +209,14 @@ StaticCalibration calibrateStatic(const StaticCapture& capture, const config::Ri
     po.num_threads = opt.num_threads;
     po.exhaustive = false;
     po.deadline_covers_global = true;
-    const double left = std::max(0.0, opt.deadline_s - since(t_ll));
+    const double left = std::max(0.0, ensembles_s - since(t_plan));
     po.deadline_s = left / double(capture.calibration.size() - k);
     CloudPairResult pair = registerCloudPair(*target, *source, rig.parameters, po);
     // The ensemble's cost leaves a tilted lidar's tilt weak where the two see different floor: both
     // floors, fitted in each lidar's frame, fix tilt and height; the structure on them yaw and x/y.
     std::optional<SharedGroundRefinement> floor;
     if (pair.ok) {
-      const Eigen::Vector3d up = T_base_mapping.linear().transpose() * Eigen::Vector3d::UnitZ();
-      floor = refineWithSharedGround(*target, *source, pair.T_target_source, up);
+      floor = floor_reference.refine(*source, pair.T_target_source);
       if (floor->applied) pair.T_target_source = floor->T_target_source;
     }
     const auto weak = weakDirections(pair.information, floor ? &*floor : nullptr);

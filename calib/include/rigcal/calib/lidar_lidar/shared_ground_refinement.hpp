@@ -9,6 +9,7 @@
 // yaw about the floor normal and the translation along the floor are left: a point-to-plane ICP over the
 // off-floor points, restricted to those three directions (the floor constraints stay exact), refines them.
 #include <cstddef>
+#include <memory>
 #include <string>
 
 #include <Eigen/Core>
@@ -52,11 +53,29 @@ struct SharedGroundRefinement {
   double seconds = 0.0;
 };
 
-/// `T_target_source` is the ensemble's result; `up_in_target` the expected up in the target's frame (the
-/// base's z). Never throws for bad data: without a floor in either cloud (or with an implausibly large
-/// correction) applied = false and T_target_source is returned unchanged.
-SharedGroundRefinement refineWithSharedGround(const Scan& target, const Scan& source, const Pose& T_target_source,
-                                              const Eigen::Vector3d& up_in_target,
-                                              const SharedGroundSettings& settings = {});
+/// The target's side, built once and shared by every calibration lidar: its floor plane and the
+/// structure above it (normals for the ICP). `up_in_target` is the expected up in the target's frame (the
+/// base's z). Never throws for bad data: without a floor, ok() is false and refine() returns unchanged.
+class SharedGroundReference {
+ public:
+  SharedGroundReference(const Scan& target, const Eigen::Vector3d& up_in_target,
+                        const SharedGroundSettings& settings = {});
+  ~SharedGroundReference();
+  SharedGroundReference(const SharedGroundReference&) = delete;
+  SharedGroundReference& operator=(const SharedGroundReference&) = delete;
+
+  [[nodiscard]] bool ok() const;
+  [[nodiscard]] double buildSeconds() const { return build_seconds_; }
+
+  /// `T_target_source` is the ensemble's result. Without a floor in the source (or with an implausibly
+  /// large correction) applied = false and T_target_source is returned unchanged.
+  [[nodiscard]] SharedGroundRefinement refine(const Scan& source, const Pose& T_target_source) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  SharedGroundSettings settings_;
+  double build_seconds_ = 0.0;
+};
 
 }  // namespace rigcal::calib
