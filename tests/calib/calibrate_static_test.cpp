@@ -96,11 +96,16 @@ TEST(CalibrateStatic, BayFromGuessesOffByAFewDegrees) {
   EXPECT_TRUE(report["base_lidar"]["ok"].get<bool>()) << report["base_lidar"].dump(2);
   for (const char* f : {"calibration.yaml", "map.pcd", "side_left_after.pcd", "side_right_before.pcd", "overview.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
-  // One calibration_deadline_s for the lidar-lidar stage of both lidars (global stages and ensembles); the
-  // final polish and the information after each ensemble come on top (measured 0.7 s at load 8-12).
+  // One calibration_deadline_s for the whole calibration after the capture: the ensembles stop at 80 % of
+  // it and leave the rest to the polish, information, floor refinement and base-lidar. What is not cut
+  // (each pair's target build and global stage before its ensemble, the polish after it) grows with the
+  // machine's load: measured 11.5-15.8 s of plan (4.7-5.0 CPU-s) at load 13-16 on the shared 2 cores. The
+  // bound allows such a machine; it catches a plan that ignores the deadline (uncut: 18 CPU-s, 57 s there).
   if (kWallClockAsserted) {
-    EXPECT_LT(report["stage_seconds"]["lidar_lidar"].get<double>(), 1.2 * report["deadline_s"].get<double>() + 2.0)
-        << report["stage_seconds"];
+    double plan = 0.0;
+    for (const char* stage : {"stillness", "accumulate", "shared_floor_reference", "lidar_lidar", "base_lidar"})
+      plan += report["stage_seconds"][stage].get<double>();
+    EXPECT_LT(plan, 1.5 * report["deadline_s"].get<double>() + 3.0) << report["stage_seconds"];
   }
   std::printf("static calibration of 3 lidars: %.1f s wall, stages %s\n", seconds, report["stage_seconds"].dump().c_str());
 }
