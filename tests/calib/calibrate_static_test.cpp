@@ -5,6 +5,8 @@
 //  - the bay from guesses 1 m / 60° off (the tilted side lidars), through the full-turn global stage;
 //  - the degenerate bay (a flat floor and one wall): unverified, the free direction named, exit 6;
 //  - the vehicle driving off during the capture: refused (exit 5) saying when and how much it moved;
+//  - the vehicle rolling in first: the capture waits until it has stood for 0.5 s; never still: exit 5;
+//  - the bay from its MCAP (`--bag`, `--topic`) as from its pcap;
 //  - live: `calibrate --static --live` on loopback ports fed by `rigcal replay --rate 1 --clock now`.
 // Bounds: see kMaxCm / kMaxDeg below (measured numbers there).
 #include <gtest/gtest.h>
@@ -30,12 +32,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Measured (Release, machine shared at load 8-10), errors of T_mapping_calib from the preset's guesses:
-// side_left 0.79 cm 0.42°, side_right 0.52 cm 0.28°; base z 0.006 cm, roll/pitch 0.032°. The issue asks
-// for 0.05°: not reached (the single viewpoint's ring-striped floor and walls bias roll/pitch; see the
-// branch's report). These bounds catch a wrong basin or a broken pipeline, not the last tenth of a degree.
-constexpr double kMaxCm = 1.5;
-constexpr double kMaxDeg = 0.6;
+// The issue's bound. Measured (Release, machine shared at load 3-7), errors of T_mapping_calib with the
+// shared-floor refinement: side_left 0.22 cm 0.007°, side_right 0.24 cm 0.007°, from the preset's guesses
+// and from 1 m / 60° off alike (the ensemble alone: 0.97 cm 0.38° and 0.42 cm 0.30°); base z 0.04 cm,
+// roll/pitch 0.005-0.012°.
+constexpr double kMaxCm = 1.0;
+constexpr double kMaxDeg = 0.05;
 
 std::string presetText(const std::string& name) { return readText(std::filesystem::path(RIGCAL_SCENARIOS_DIR) / (name + ".yaml")); }
 
@@ -94,11 +96,16 @@ TEST(CalibrateStatic, BayFromGuessesOffByAFewDegrees) {
   EXPECT_TRUE(report["base_lidar"]["ok"].get<bool>()) << report["base_lidar"].dump(2);
   for (const char* f : {"calibration.yaml", "map.pcd", "side_left_after.pcd", "side_right_before.pcd", "overview.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
-  // One calibration_deadline_s for the lidar-lidar stage of both lidars (global stages and ensembles); the
-  // final polish and the information after each ensemble come on top (measured 0.7 s at load 8-12).
+  // One calibration_deadline_s for the whole calibration after the capture: the ensembles stop at 80 % of
+  // it and leave the rest to the polish, information, floor refinement and base-lidar. What is not cut
+  // (each pair's target build and global stage before its ensemble, the polish after it) grows with the
+  // machine's load: measured 11.5-15.8 s of plan (4.7-5.0 CPU-s) at load 13-16 on the shared 2 cores. The
+  // bound allows such a machine; it catches a plan that ignores the deadline (uncut: 18 CPU-s, 57 s there).
   if (kWallClockAsserted) {
-    EXPECT_LT(report["stage_seconds"]["lidar_lidar"].get<double>(), 1.2 * report["deadline_s"].get<double>() + 2.0)
-        << report["stage_seconds"];
+    double plan = 0.0;
+    for (const char* stage : {"stillness", "accumulate", "shared_floor_reference", "lidar_lidar", "base_lidar"})
+      plan += report["stage_seconds"][stage].get<double>();
+    EXPECT_LT(plan, 1.5 * report["deadline_s"].get<double>() + 3.0) << report["stage_seconds"];
   }
   std::printf("static calibration of 3 lidars: %.1f s wall, stages %s\n", seconds, report["stage_seconds"].dump().c_str());
 }
@@ -158,6 +165,90 @@ TEST(CalibrateStatic, VehicleMovingDuringTheCaptureIsRefused) {
   const auto report = readJson(dir / "out" / "report.json");
   EXPECT_EQ(report["status"], "failed");
   EXPECT_EQ(report["input"]["still"], "no");
+}
+
+// The recording starts with the vehicle rolling into the bay (2.5 s at up to 4 km/h), then it stands for
+// 3 s: the capture waits until the mapping sweeps agreed for 0.5 s, and the result is as from a parked
+// start. --deadline 4: the shared-floor refinement lands on the same answer as with the default 10 s
+// (measured 0.32 cm / 0.004° and 0.16 cm / 0.007° both ways), at 4 CPU-s instead of 10.
+TEST(CalibrateStatic, CaptureWaitsUntilTheVehicleHasParked) {
+  if (kSanitized) GTEST_SKIP() << "seconds of registration in Release: minutes under sanitizers";
+  TempDir dir;
+  const std::string yaml = replaced(presetText("calibration-bay"), "    - {type: stop, duration: 3.0}",
+                                    "    - {type: accelerate, to_kmh: 4, duration: 1.5}\n"
+                                    "    - {type: decelerate, to_kmh: 0, duration: 1.0}\n"
+                                    "    - {type: stop, duration: 3.0}");
+  ASSERT_NO_FATAL_FAILURE(simulateYaml(yaml, dir / "sim"));
+  double seconds = 0.0;
+  const auto r = calibrateStatic(dir / "sim", dir / "out", &seconds, {"--deadline", "4"});
+  ASSERT_NO_FATAL_FAILURE(expectOkOrNamedDoubt(r, dir / "out"));
+  const auto report = readJson(dir / "out" / "report.json");
+  EXPECT_EQ(report["input"]["still"], "yes");
+  EXPECT_EQ(report["input"]["capture_complete"], "yes");
+  // Moving for the first 2.5 s (the last tenths at a crawl): no still half-second before ~2 s.
+  const double waited = std::stod(report["input"]["waited_for_stillness_s"].get<std::string>());
+  EXPECT_GT(waited, 2.0) << "opened while the vehicle still moved";
+  EXPECT_LT(waited, 3.2) << "kept waiting after the vehicle stood";
+  EXPECT_LT(std::stod(report["input"]["max_motion_m"].get<std::string>()), 0.03);
+  expectCloseToTruth(dir / "sim", dir / "out");
+}
+
+// Also under the sanitizers (the driver threads waiting for the watch; no registration runs).
+TEST(CalibrateStatic, VehicleNeverStillIsRefused) {
+  TempDir dir;
+  const std::string yaml = replaced(presetText("calibration-bay"), "    - {type: stop, duration: 3.0}",
+                                    "    - {type: accelerate, to_kmh: 2, duration: 1.0}\n    - {type: cruise, duration: 2.0}");
+  ASSERT_NO_FATAL_FAILURE(simulateYaml(yaml, dir / "sim"));
+  double seconds = 0.0;
+  const auto r = calibrateStatic(dir / "sim", dir / "out", &seconds);
+  EXPECT_EQ(r.exit_code, 5) << r.err;
+  EXPECT_TRUE(std::regex_search(r.err, std::regex(R"(never still for 0\.50 s: watched [0-9]+ mapping sweeps over [0-9.]+ s, the longest still stretch [0-9.]+ s)")))
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+  const auto report = readJson(dir / "out" / "report.json");
+  EXPECT_EQ(report["status"], "failed");
+  EXPECT_EQ(report["input"]["still"], "no");
+}
+
+// The same parked bay from the simulator's packet MCAP (`rigcal sim --format both`; source.topic, --topic,
+// initial_extrinsics: from_bag) as from its pcap: the same sweeps, so the same calibration (measured identical to the µm). --deadline 3:
+// the shared-floor refinement settles both on the same minimum (about 3 CPU-s each).
+TEST(CalibrateStatic, FromTheBaysMcapAsFromItsPcap) {
+  if (kSanitized) GTEST_SKIP() << "seconds of registration in Release: minutes under sanitizers";
+  TempDir dir;
+  const auto sim = runRigcal({"sim", "--scenario", "calibration-bay", "--format", "both", "--out", (dir / "sim").string()});
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  double seconds = 0.0;
+  const auto from_pcap = calibrateStatic(dir / "sim", dir / "pcap", &seconds, {"--deadline", "3"});
+  ASSERT_NO_FATAL_FAILURE(expectOkOrNamedDoubt(from_pcap, dir / "pcap"));
+  // The bag's own way of naming things: each lidar's source.topic and frame, the initial extrinsics from
+  // its /tf_static (the simulator writes the rig's guesses there); --topic overrides one of them.
+  std::string rig = readText(dir / "sim" / "rig.yaml");
+  for (const char* lidar : {"top", "side_left", "side_right"})
+    rig = std::regex_replace(rig, std::regex(std::string("(- name: ") + lidar + "\n    model: [^\n]+\n    source: \\{)"),
+                             std::string("$1topic: /") + lidar + "/packets, frame: " + lidar + ", ");
+  rig = std::regex_replace(rig, std::regex("initial_extrinsics:\n(  [^\n]*\n)+"), "initial_extrinsics: from_bag\n");
+  ASSERT_NE(rig.find("initial_extrinsics: from_bag"), std::string::npos) << rig;
+  ASSERT_NE(rig.find("topic: /side_right/packets, frame: side_right"), std::string::npos) << rig;
+  std::ofstream(dir / "sim" / "from_bag.yaml") << rig;  // beside the vendor files it names
+  const std::vector<std::string> args{"calibrate", "--static", "--config", (dir / "sim" / "from_bag.yaml").string(),
+                                      "--bag", (dir / "sim" / "recording.mcap").string(), "--out", (dir / "bag").string(),
+                                      "--deadline", "3", "--topic", "side_left=/side_left/packets"};
+  const auto from_bag = runRigcal(args);
+  std::printf("%s%s", from_bag.out.c_str(), from_bag.err.c_str());
+  ASSERT_NO_FATAL_FAILURE(expectOkOrNamedDoubt(from_bag, dir / "bag"));
+  const auto pcap_report = readJson(dir / "pcap" / "report.json");
+  const auto bag_report = readJson(dir / "bag" / "report.json");
+  EXPECT_EQ(bag_report["input"]["source"], (dir / "sim" / "recording.mcap").string());
+  EXPECT_EQ(bag_report["input"]["mapping_sweeps"], pcap_report["input"]["mapping_sweeps"]);
+  for (const char* lidar : {"top", "side_left", "side_right"}) {
+    const auto& a = pcap_report["T_base_sensor"][lidar];
+    const auto& b = bag_report["T_base_sensor"][lidar];
+    for (const char* k : {"x", "y", "z"}) EXPECT_NEAR(a[k].get<double>(), b[k].get<double>(), 1e-3) << lidar << " " << k;
+    for (const char* k : {"roll", "pitch", "yaw"})
+      EXPECT_NEAR(a[k].get<double>(), b[k].get<double>(), 1e-4) << lidar << " " << k;  // rad: 0.006°
+  }
+  expectCloseToTruth(dir / "sim", dir / "bag");
 }
 
 // True once a UDP socket is bound to `port` (/proc/net/udp lists local ports in hex).

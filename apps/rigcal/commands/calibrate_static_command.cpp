@@ -1,14 +1,17 @@
-// `rigcal calibrate --static --config RIG (--pcap F | --live | --shm) [--out DIR] [--deadline S]`: a parked
-// vehicle. Every lidar's sweeps over static_capture_s are accumulated (static_capture.cpp); the mapping
-// lidar's sweeps must agree with its first (else refused: when and how much it moved); each calibration
-// lidar's cloud is registered to the mapping lidar's with `rigcal register`'s global stage and ensemble
-// (calib/static_calibration.cpp); base-lidar from the ground; the outputs and exit codes of `calibrate`.
+// `rigcal calibrate --static --config RIG (--pcap F | --bag B [--topic S=T]... | --live | --shm) [--out DIR]
+// [--deadline S]`: a parked vehicle. Once the mapping lidar's sweeps agreed for 0.5 s, every lidar's sweeps
+// over static_capture_s are accumulated (static_capture.cpp); the mapping lidar's sweeps must agree with
+// the capture's first (else refused: when and how much it moved); each calibration lidar's cloud is
+// registered to the mapping lidar's with `rigcal register`'s global stage and ensemble, then refined on
+// the shared floor (calib/static_calibration.cpp); base-lidar from the ground; the outputs and exit codes
+// of `calibrate`.
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
 
+#include "../bag_extrinsics.hpp"
 #include "../calibrate_static.hpp"
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
@@ -40,7 +43,8 @@ void runCalibrateStatic(const std::string& config, const PipelineCliOptions& inp
   const auto t_start = Clock::now();
   config::RigConfig rig = loadRig(config);
   if (deadline >= 0) rig.parameters.calibration_deadline_s = deadline;
-  const pipeline::PipelineOptions po = toPipelineOptions(input);
+  pipeline::PipelineOptions po = toPipelineOptions(input);
+  applyExtrinsicsFromBag(rig, po);  // `initial_extrinsics: from_bag`: the bag's tf tree
   prepareOutputFolder(out_dir);
   const std::filesystem::path out(out_dir);
 
@@ -58,7 +62,9 @@ void runCalibrateStatic(const std::string& config, const PipelineCliOptions& inp
   so.deadline_s = rig.parameters.calibration_deadline_s;
   calib::StaticCalibration sc;
   std::string shortfall;
-  if (cap.capture.mapping.empty()) {
+  if (!cap.settled && !cap.never_still.empty() && !interrupted) {
+    shortfall = "static: " + cap.never_still;
+  } else if (cap.capture.mapping.empty()) {
     shortfall = "no complete sweep of the mapping lidar " + rig.roles.mapping_lidar + " in the input";
   } else {
     sc = calib::calibrateStatic(cap.capture, rig, so);
@@ -74,6 +80,7 @@ void runCalibrateStatic(const std::string& config, const PipelineCliOptions& inp
   }
   outcome.version = RIGCAL_VERSION;
   const std::string source = po.input == pipeline::InputKind::kPcap ? po.pcap.string()
+                             : po.input == pipeline::InputKind::kBag  ? po.bag.string()
                              : po.input == pipeline::InputKind::kLive ? std::string("live")
                                                                        : std::string("shm");
   std::vector<std::pair<std::string, std::string>> summary = {
@@ -83,7 +90,8 @@ void runCalibrateStatic(const std::string& config, const PipelineCliOptions& inp
       {"captured_s", fixed(cap.capture.capture_s, 2)},
       {"capture_complete", cap.complete ? "yes" : "no (the input ended first)"},
       {"mapping_sweeps", std::to_string(cap.capture.mapping.size())},
-      {"still", sc.stillness.still ? "yes" : "no"},
+      {"waited_for_stillness_s", fixed(cap.waited_s, 2)},
+      {"still", cap.settled && sc.stillness.still ? "yes" : "no"},
       {"max_motion_m", fixed(sc.stillness.largest.metres, 4)},
       {"max_motion_deg", fixed(sc.stillness.largest.degrees, 3)},
       {"interrupted", interrupted ? "yes" : "no"}};

@@ -8,6 +8,8 @@
 
 #include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
+#include "rigcal/calib/lidar_lidar/shared_ground_refinement.hpp"
+#include "rigcal/calib/lidar_lidar/stillness_watch.hpp"
 #include "rigcal/registration/icp.hpp"
 #include "rigcal/registration/target.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
@@ -19,9 +21,6 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Voxel of the stillness check: fine enough that a 1 cm shift moves the ICP minimum, coarse enough that a
-// 64-beam sweep registers in a few ms.
-constexpr double kStillnessVoxel = 0.2;
 // The accumulated clouds: 2 cm centroids average the sweeps' range noise without blurring any edge.
 constexpr double kAccumulationVoxel = 0.02;
 // Metres the base-lidar crop box grows by around the vehicle's footprint (a 64-beam roof lidar at 2 m
@@ -63,13 +62,13 @@ std::string fixed(double v, int digits) {
 
 // The static verdict: the lidar-lidar rules with the accumulated cloud as the one frame there is, then the
 // scene's own doubts (directions it leaves free, a second basin as good as the best).
-void judgeStatic(LidarLidarResult& r, const CloudPairResult& pair, double deadline_s, double min_uniqueness) {
+void judgeStatic(LidarLidarResult& r, const CloudPairResult& pair, const std::vector<std::string>& weak,
+                 double deadline_s, double min_uniqueness) {
   VerdictOptions vo;
   vo.min_frames = 1;  // one accumulated cloud: the registrators' agreement and the inliers are the evidence
   judgeLidarLidar(r, 1, deadline_s, vo);
   if (r.verdict == Verdict::kFailed) return;
   std::vector<std::string> doubts;
-  const auto weak = pair.information.weakDirections();
   if (!weak.empty()) {
     std::string names;
     for (const auto& w : weak) names += (names.empty() ? "" : ", ") + w;
@@ -90,6 +89,22 @@ void judgeStatic(LidarLidarResult& r, const CloudPairResult& pair, double deadli
   r.verdict = Verdict::kUnverified;
 }
 
+// The pair's weak directions, less those the shared floor fixed: a tilt (a rotation axis along the floor)
+// and the height (a translation across it). What the floor leaves free (yaw, along the floor) stays weak.
+std::vector<std::string> weakDirections(const RegistrationInformation& info, const SharedGroundRefinement* floor) {
+  std::vector<std::string> weak;
+  const auto fixedByFloor = [&](const DirectionInformation& d, bool rotation) {
+    if (floor == nullptr || !floor->applied) return false;
+    const double along_normal = std::abs(d.direction.dot(floor->floor_normal));
+    return rotation ? along_normal < 0.5 : along_normal > 0.87;  // within 30° of the floor / of its normal
+  };
+  for (const auto& d : info.translation)
+    if (d.weak && !fixedByFloor(d, false)) weak.push_back(d.name);
+  for (const auto& d : info.rotation)
+    if (d.weak && !fixedByFloor(d, true)) weak.push_back(d.name);
+  return weak;
+}
+
 }  // namespace
 
 StillnessCheck checkStillness(const ScanList& scans, const config::Parameters& params) {
@@ -101,31 +116,18 @@ StillnessCheck checkStillness(const ScanList& scans, const config::Parameters& p
     c.seconds = since(t0);
     return c;
   }
-  registration::TargetOptions to;
-  to.normals_and_covariances = true;
-  to.num_threads = 2;
-  const registration::Target first(
-      registration::voxelDownsample(registration::fromScan(*scans.front()), kStillnessVoxel), to);
-  registration::IcpParams p;
-  p.method = registration::IcpMethod::kPointToPlane;
-  p.max_correspondence_distance = 1.0;  // a moving vehicle's sweeps are still matched a metre apart
-  p.max_iterations = 50;
-  p.coarse_to_fine = true;
-  p.check_degeneracy = false;
-  p.num_threads = 2;
+  const SweepRegistrar first(*scans.front());
   Pose previous = Pose::Identity();  // each sweep starts from the previous one's pose: motion is smooth
   for (std::size_t k = 1; k < scans.size(); ++k) {
     if (scans[k] == nullptr) continue;
-    const auto source = registration::voxelDownsample(registration::fromScan(*scans[k]), kStillnessVoxel);
-    if (source.size() < 50 || first.size() < 50) continue;
-    const auto r = registration::alignIcp(first, source, previous, p);
-    if (!r.T_target_source.matrix().allFinite()) continue;
-    previous = r.T_target_source;
+    const auto T = first.motion(*scans[k], previous);
+    if (!T) continue;
+    previous = *T;
     StillnessSample s;
     s.scan = k;
     s.t_s = toSeconds(scans[k]->stamp_ns - scans.front()->stamp_ns);
-    s.metres = r.T_target_source.translation().norm();
-    s.degrees = rad2deg(rotationAngleBetween(r.T_target_source, Pose::Identity()));
+    s.metres = T->translation().norm();
+    s.degrees = rad2deg(rotationAngleBetween(*T, Pose::Identity()));
     c.samples.push_back(s);
     if (s.metres > c.largest.metres || (s.metres == c.largest.metres && s.degrees > c.largest.degrees)) c.largest = s;
     if (!c.first_moved && (s.metres > c.limit_m || s.degrees > c.limit_deg)) c.first_moved = s;
@@ -161,6 +163,7 @@ Scan accumulateSweeps(const ScanList& scans, double voxel) {
 
 StaticCalibration calibrateStatic(const StaticCapture& capture, const config::RigConfig& rig,
                                   const StaticCalibrationOptions& opt) {
+  const auto t_plan = Clock::now();
   StaticCalibration out;
   CalibrationOutcome& o = out.outcome;
   o.rig_name = rig.name;
@@ -184,9 +187,15 @@ StaticCalibration calibrateStatic(const StaticCapture& capture, const config::Ri
   auto target = std::make_shared<const Scan>(accumulateSweeps(capture.mapping, kAccumulationVoxel));
   o.map_cloud = target;
   o.stage_seconds.emplace_back("accumulate", since(t_acc));
+  // The floor and the structure on it under the mapping lidar, for every calibration lidar's refinement.
+  const SharedGroundReference floor_reference(*target,
+                                              T_base_mapping.linear().transpose() * Eigen::Vector3d::UnitZ());
+  o.stage_seconds.emplace_back("shared_floor_reference", floor_reference.buildSeconds());
 
-  // Each calibration lidar in turn, each with an equal share of what is left of the deadline.
+  // Each calibration lidar in turn, each with an equal share of what is left of the deadline less the
+  // share kept for what comes after the ensembles (polish, information, floor refinement, base-lidar).
   const auto t_ll = Clock::now();
+  const double ensembles_s = (1.0 - opt.later_share) * opt.deadline_s;
   for (std::size_t k = 0; k < capture.calibration.size(); ++k) {
     const auto& [sensor, scans] = capture.calibration[k];
     const Pose guess = T_base_mapping.inverse() * rig.initial_T_base_sensor.at(sensor);
@@ -200,9 +209,17 @@ StaticCalibration calibrateStatic(const StaticCapture& capture, const config::Ri
     po.num_threads = opt.num_threads;
     po.exhaustive = false;
     po.deadline_covers_global = true;
-    const double left = std::max(0.0, opt.deadline_s - since(t_ll));
+    const double left = std::max(0.0, ensembles_s - since(t_plan));
     po.deadline_s = left / double(capture.calibration.size() - k);
     CloudPairResult pair = registerCloudPair(*target, *source, rig.parameters, po);
+    // The ensemble's cost leaves a tilted lidar's tilt weak where the two see different floor: both
+    // floors, fitted in each lidar's frame, fix tilt and height; the structure on them yaw and x/y.
+    std::optional<SharedGroundRefinement> floor;
+    if (pair.ok) {
+      floor = floor_reference.refine(*source, pair.T_target_source);
+      if (floor->applied) pair.T_target_source = floor->T_target_source;
+    }
+    const auto weak = weakDirections(pair.information, floor ? &*floor : nullptr);
 
     LidarLidarResult r = pair.ensemble;
     r.mapping_sensor = rig.roles.mapping_lidar;
@@ -215,15 +232,27 @@ StaticCalibration calibrateStatic(const StaticCapture& capture, const config::Ri
     r.initial_score = pair.guess_score;
     r.final_score = pair.final_score;
     r.seconds = pair.seconds;
-    judgeStatic(r, pair, opt.deadline_s, opt.min_uniqueness);
+    judgeStatic(r, pair, weak, opt.deadline_s, opt.min_uniqueness);
 
     o.datasets.push_back(staticDataset(rig.roles.mapping_lidar, sensor, target, source, T_base_mapping, guess));
     o.lidars.push_back(std::move(r));
     o.input_summary.emplace_back(sensor + "_sweeps", std::to_string(scans.size()));
     o.input_summary.emplace_back(sensor + "_overlap", fixed(pair.source_overlap, 3));
-    std::string weak;
-    for (const auto& w : pair.information.weakDirections()) weak += (weak.empty() ? "" : " ") + w;
-    o.input_summary.emplace_back(sensor + "_weak_directions", weak.empty() ? "none" : weak);
+    std::string weak_names;
+    for (const auto& w : weak) weak_names += (weak_names.empty() ? "" : " ") + w;
+    o.input_summary.emplace_back(sensor + "_weak_directions", weak_names.empty() ? "none" : weak_names);
+    if (floor) {
+      o.input_summary.emplace_back(
+          sensor + "_shared_floor",
+          floor->applied ? "tilt " + fixed(floor->tilt_correction_deg, 3) + " deg, height " +
+                               fixed(100 * floor->height_correction_m, 2) + " cm, yaw " +
+                               fixed(floor->yaw_correction_deg, 3) + " deg, along the floor " +
+                               fixed(100 * floor->planar_correction_m, 2) + " cm (" +
+                               std::to_string(floor->source_floor_points) + " / " +
+                               std::to_string(floor->target_floor_points) + " floor points)"
+                         : "not applied: " + floor->note);
+      o.stage_seconds.emplace_back(sensor + "_shared_floor", floor->seconds);
+    }
     if (pair.global && pair.global->second_score)
       o.input_summary.emplace_back(sensor + "_second_basin_ratio",
                                    fixed(*pair.global->second_score / std::max(pair.global->best_score, 1e-12), 2));

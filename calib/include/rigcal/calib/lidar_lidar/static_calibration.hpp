@@ -61,7 +61,11 @@ struct StaticCapture {
 };
 
 struct StaticCalibrationOptions {
-  double deadline_s = 10.0;  // calibration_deadline_s, shared by the calibration lidars
+  double deadline_s = 10.0;  // calibration_deadline_s: the whole calibration (after the capture)
+  /// Share of the deadline kept for what follows the ensembles (the final polish, information and
+  /// shared-floor refinement of each lidar, base-lidar): the global stages and ensembles of all the
+  /// calibration lidars share the rest.
+  double later_share = 0.2;
   int num_threads = 2;
   /// A second basin whose score is within this factor of the best one makes the result ambiguous.
   double min_uniqueness = 1.25;
