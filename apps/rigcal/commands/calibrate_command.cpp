@@ -37,6 +37,7 @@
 #include "rigcal/calib/outputs/summary_table.hpp"
 #include "rigcal/config/config_error.hpp"
 #include "rigcal/config/rig_config.hpp"
+#include "rigcal/core/heap_release.hpp"
 #include "rigcal/pipeline/clock_offset_estimate.hpp"
 #include "rigcal/pipeline/pipeline.hpp"
 
@@ -69,6 +70,7 @@ std::string progressLine(const pipeline::PipelineProgress& p) {
 
 void run(const CalibrateOptions& o) {
   const auto t_start = Clock::now();
+  returnLargeBlocksToTheSystem();  // issue #18: peak memory on embedded targets
   config::RigConfig rig = loadRig(o.config);
   if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
   pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);

@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "rigcal/core/heap_release.hpp"
+
 namespace rigcal::calib {
 
 LidarLidarWorker::LidarLidarWorker(const config::Parameters& params, std::size_t calibration_lidars,
@@ -59,8 +61,11 @@ void LidarLidarWorker::loop() {
       pending_.pop_front();
       ++started_;
     }
+    // The pipeline's freed clouds before the targets are built, the targets once they are freed.
+    releaseFreedHeap();
     const auto t0 = std::chrono::steady_clock::now();
     LidarLidarResult result = calibrateLidarLidar(*dataset, params_, budget_.next(), options_);
+    releaseFreedHeap();
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     results.push_back(std::move(result));
     datasets.push_back(*dataset);

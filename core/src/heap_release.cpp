@@ -1,0 +1,25 @@
+#include "rigcal/core/heap_release.hpp"
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+namespace rigcal {
+
+namespace {
+constexpr int kMmapThresholdBytes = 1 << 20;  // a mapping-lidar scan is several MiB, a small vector far less
+}  // namespace
+
+void returnLargeBlocksToTheSystem() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, kMmapThresholdBytes);
+#endif
+}
+
+void releaseFreedHeap() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
+
+}  // namespace rigcal
