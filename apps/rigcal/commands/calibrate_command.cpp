@@ -91,7 +91,10 @@ void run(const CalibrateOptions& o) {
   StopSignals signals;
   // Every calibration lidar shares one calibration_deadline_s, whenever its dataset comes (budget full
   // during the drive, or end of input).
-  calib::LidarLidarWorker worker(rig.parameters, rig.roles.calibration_lidars.size());
+  // The outputs' map comes from the pipeline (MappingResult::map_cloud): the datasets' mapping clouds go
+  // once each lidar is calibrated.
+  calib::LidarLidarWorker worker(rig.parameters, rig.roles.calibration_lidars.size(), {}, nullptr,
+                                 /*keep_mapping_clouds=*/false);
   std::unique_ptr<pipeline::Pipeline> pipe;
   try {
     pipe = std::make_unique<pipeline::Pipeline>(rig, po, [&](std::shared_ptr<const pipeline::CalibrationDataset> d) {
