@@ -8,11 +8,13 @@ namespace rigcal {
 
 namespace {
 constexpr int kMmapThresholdBytes = 1 << 20;  // a mapping-lidar scan is several MiB, a small vector far less
+constexpr int kMaxArenas = 2;                 // parking-lot demo: peak RSS −130 MB, CPU time unchanged
 }  // namespace
 
-void returnLargeBlocksToTheSystem() {
+void limitHeapRetention() {
 #if defined(__GLIBC__)
   mallopt(M_MMAP_THRESHOLD, kMmapThresholdBytes);
+  mallopt(M_ARENA_MAX, kMaxArenas);
 #endif
 }
 

@@ -70,7 +70,7 @@ std::string progressLine(const pipeline::PipelineProgress& p) {
 
 void run(const CalibrateOptions& o) {
   const auto t_start = Clock::now();
-  returnLargeBlocksToTheSystem();  // issue #18: peak memory on embedded targets
+  limitHeapRetention();  // issue #18: peak memory on embedded targets
   config::RigConfig rig = loadRig(o.config);
   if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
   pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
