@@ -35,6 +35,24 @@ bool usesNdt(const config::Parameters& p) {
   return false;
 }
 
+/// A stored frame's cloud: x, y, z only, the other arrays empty (nobody reads them: the voxel centroids
+/// have no intensity, ring or time). Half the bytes of a full Scan: a drive keeps hundreds of these.
+Scan positionsOnly(const reg::PointCloud& cloud, const Scan& like) {
+  Scan s;
+  s.sensor_id = like.sensor_id;
+  s.sequence = like.sequence;
+  s.stamp_ns = like.stamp_ns;
+  s.x.reserve(cloud.size());
+  s.y.reserve(cloud.size());
+  s.z.reserve(cloud.size());
+  for (const auto& p : cloud.points) {
+    s.x.push_back(float(p.x()));
+    s.y.push_back(float(p.y()));
+    s.z.push_back(float(p.z()));
+  }
+  return s;
+}
+
 MapperOutput skipped(std::string why) {
   MapperOutput out;
   out.skipped_reason = std::move(why);
@@ -217,8 +235,8 @@ struct Mapper::Impl {
 
   void finishFrame(MapperOutput& out) {
     if (out.deskewed) {
-      out.cloud = std::make_shared<const Scan>(reg::toScan(
-          reg::voxelDownsample(reg::fromScan(*out.deskewed), params.leaf_size_dense_map), *out.deskewed));
+      out.cloud = std::make_shared<const Scan>(
+          positionsOnly(reg::voxelDownsample(reg::fromScan(*out.deskewed), params.leaf_size_dense_map), *out.deskewed));
       out.deskewed.reset();
     }
     if (pending_keyframe) {

@@ -22,9 +22,9 @@ void Pipeline::Impl::deskewStage() {
       if (p->end) traj_ended = true;
       else traj.add(p->stamp, p->pose);
     }
-    while (!input_ended) {
-      auto s = q_in.tryPop();
-      if (!s) break;
+    // One input scan per round, then the held scans the trajectory now covers: while the mapper is the
+    // bottleneck q_in is never empty, and draining it first held every calibration scan to the end of input.
+    if (auto s = input_ended ? std::nullopt : q_in.tryPop()) {
       progress = true;
       if (s->end) {
         input_ended = true;
@@ -197,10 +197,14 @@ void Pipeline::Impl::selectorStage() {
     if (!item) continue;
     if (item->end) {
       std::vector<Shortfall> missing;
+      // Every lane's dataset first: each then holds only its selected windows, and the other candidates'
+      // clouds are gone before the first calibration (delivered offline) starts building targets.
+      std::vector<std::pair<std::shared_ptr<const CalibrationDataset>, std::size_t>> ready;
       for (std::size_t i = 0; i < selection.size(); ++i) {
-        if (auto d = selection[i].finish()) deliver(d, i);
+        if (auto d = selection[i].finish()) ready.emplace_back(std::move(d), i);
         else if (!selection[i].handedOver()) missing.push_back(selection[i].shortfall());
       }
+      for (auto& [d, i] : ready) deliver(d, i);
       std::lock_guard lock(result_mutex);
       shortfalls = std::move(missing);
       return;

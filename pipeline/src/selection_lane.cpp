@@ -32,8 +32,7 @@ std::shared_ptr<const CalibrationDataset> SelectionLane::add(CandidateMessage ca
   if (!records_.back().c.pairing.accepted) return nullptr;
   reselect();
   if (!selection_.budgetFull(params_)) return nullptr;
-  handed_over_ = true;
-  return dataset(true);
+  return handOver(true);
 }
 
 void SelectionLane::reselect() {
@@ -53,8 +52,15 @@ void SelectionLane::reselect() {
 
 std::shared_ptr<const CalibrationDataset> SelectionLane::finish() {
   if (handed_over_ || !selection_.enough(params_)) return nullptr;
+  return handOver(false);
+}
+
+std::shared_ptr<const CalibrationDataset> SelectionLane::handOver(bool budget_full) {
   handed_over_ = true;
-  return dataset(false);
+  auto d = dataset(budget_full);
+  // The dataset holds the selected windows; no other dataset will come from this lane: the rest can go.
+  for (Record& r : records_) r.window.clear();
+  return d;
 }
 
 std::shared_ptr<const CalibrationDataset> SelectionLane::dataset(bool budget_full) const {

@@ -46,6 +46,8 @@ class SelectionLane {
   };
   void reselect();
   std::shared_ptr<const CalibrationDataset> dataset(bool budget_full) const;
+  /// The dataset, once; then releases every record's window clouds.
+  std::shared_ptr<const CalibrationDataset> handOver(bool budget_full);
 
   CalibrationDataset base_;
   config::Parameters params_;

@@ -37,6 +37,7 @@
 #include "rigcal/calib/outputs/summary_table.hpp"
 #include "rigcal/config/config_error.hpp"
 #include "rigcal/config/rig_config.hpp"
+#include "rigcal/core/heap_release.hpp"
 #include "rigcal/pipeline/clock_offset_estimate.hpp"
 #include "rigcal/pipeline/pipeline.hpp"
 
@@ -69,6 +70,7 @@ std::string progressLine(const pipeline::PipelineProgress& p) {
 
 void run(const CalibrateOptions& o) {
   const auto t_start = Clock::now();
+  limitHeapRetention();  // issue #18: peak memory on embedded targets
   config::RigConfig rig = loadRig(o.config);
   if (o.deadline >= 0) rig.parameters.calibration_deadline_s = o.deadline;
   pipeline::PipelineOptions po = toPipelineOptions(o.pipeline);
@@ -91,7 +93,10 @@ void run(const CalibrateOptions& o) {
   // during the drive, or end of input).
   calib::LidarLidarOptions lidar_lidar;
   lidar_lidar.trajectory_clock = true;  // the clock check that needs no capture time (live, shm)
-  calib::LidarLidarWorker worker(rig.parameters, rig.roles.calibration_lidars.size(), lidar_lidar);
+  // The outputs' map comes from the pipeline (MappingResult::map_cloud): the datasets' mapping clouds go
+  // once each lidar is calibrated.
+  calib::LidarLidarWorker worker(rig.parameters, rig.roles.calibration_lidars.size(), lidar_lidar, nullptr,
+                                 /*keep_mapping_clouds=*/false);
   std::unique_ptr<pipeline::Pipeline> pipe;
   try {
     pipe = std::make_unique<pipeline::Pipeline>(rig, po, [&](std::shared_ptr<const pipeline::CalibrationDataset> d) {

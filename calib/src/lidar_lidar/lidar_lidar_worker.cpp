@@ -2,12 +2,16 @@
 
 #include <chrono>
 
+#include "rigcal/core/heap_release.hpp"
+
 namespace rigcal::calib {
 
 LidarLidarWorker::LidarLidarWorker(const config::Parameters& params, std::size_t calibration_lidars,
-                                   const LidarLidarOptions& options, const registration::CancelToken* cancel)
+                                   const LidarLidarOptions& options, const registration::CancelToken* cancel,
+                                   bool keep_mapping_clouds)
     : params_(params),
       options_(options),
+      keep_mapping_clouds_(keep_mapping_clouds),
       budget_(params.calibration_deadline_s, calibration_lidars, cancel),
       thread_([this] { loop(); }) {}
 
@@ -59,11 +63,16 @@ void LidarLidarWorker::loop() {
       pending_.pop_front();
       ++started_;
     }
+    // The pipeline's freed clouds before the targets are built; the targets (and clouds) once freed.
+    releaseFreedHeap();
     const auto t0 = std::chrono::steady_clock::now();
     LidarLidarResult result = calibrateLidarLidar(*dataset, params_, budget_.next(), options_);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     results.push_back(std::move(result));
     datasets.push_back(*dataset);
+    if (!keep_mapping_clouds_) datasets.back().mapping_clouds = {};
+    dataset.reset();  // the pipeline's reference went with the hand-over: the clouds can go now
+    releaseFreedHeap();
     {
       const std::lock_guard lock(mutex_);
       ++completed_;

@@ -8,6 +8,7 @@
 #include <concurrentqueue/concurrentqueue.h>
 #include <concurrentqueue/lightweightsemaphore.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -20,7 +21,7 @@ template <class T>
 class BoundedQueue {
  public:
   explicit BoundedQueue(std::size_t capacity)
-      : queue_(capacity), items_(0, kSpins), slots_(std::ptrdiff_t(capacity), kSpins), capacity_(capacity) {}
+      : queue_(std::min(capacity, kMaxPreallocated)), items_(0, kSpins), slots_(std::ptrdiff_t(capacity), kSpins), capacity_(capacity) {}
 
   /// Lossless: waits while the queue is full. Returns false if the queue was closed.
   bool push(T item) {
@@ -78,6 +79,9 @@ class BoundedQueue {
   [[nodiscard]] std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
 
  private:
+  // moodycamel preallocates its initial size: a 65536-item lossless queue of frames would hold tens of MB
+  // that it rarely uses. Beyond this many items it allocates blocks as they are needed.
+  static constexpr std::size_t kMaxPreallocated = 256;
   static constexpr int kSpins = 1;                  // block at once: spinning steals a core
   static constexpr std::int64_t kWakeCheckUs = 100'000;  // producers re-check close() this often
 

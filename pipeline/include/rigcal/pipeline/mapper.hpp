@@ -33,7 +33,7 @@ struct MapperOutput {
   MappingFrame frame;
   RegistrationSummary registration;
   /// Stored frames only: the deskewed cloud in the lidar frame at frame.stamp_ns, voxelised at
-  /// leaf_size_dense_map (positions; intensity is the voxel's mean, other fields zero). With
+  /// leaf_size_dense_map: positions only (x, y, z; the other arrays are empty: never point(), filter()). With
   /// Mapper::deferPostPoseWork() left empty until Mapper::finishFrame().
   std::shared_ptr<const Scan> cloud;
   /// Stored frames, deferred post-pose work only: the deskewed scan `cloud` is made from.

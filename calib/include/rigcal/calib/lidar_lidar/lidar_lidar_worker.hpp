@@ -21,8 +21,12 @@ namespace rigcal::calib {
 class LidarLidarWorker {
  public:
   /// `calibration_lidars`: how many datasets may come (the rig's calibration lidars).
+  /// `keep_mapping_clouds` false: `datasets` keeps each dataset without its mapping clouds once it is
+  /// calibrated, for a caller with a map of its own. They are most of a dataset's bytes, and the lidars
+  /// calibrated after it (the rest of the drive) would otherwise hold them too.
   LidarLidarWorker(const config::Parameters& params, std::size_t calibration_lidars,
-                   const LidarLidarOptions& options = {}, const registration::CancelToken* cancel = nullptr);
+                   const LidarLidarOptions& options = {}, const registration::CancelToken* cancel = nullptr,
+                   bool keep_mapping_clouds = true);
   ~LidarLidarWorker();  // finish()
   LidarLidarWorker(const LidarLidarWorker&) = delete;
   LidarLidarWorker& operator=(const LidarLidarWorker&) = delete;
@@ -50,6 +54,7 @@ class LidarLidarWorker {
 
   config::Parameters params_;
   LidarLidarOptions options_;
+  bool keep_mapping_clouds_;
   CalibrationBudget budget_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
