@@ -52,6 +52,7 @@ const std::vector<ParameterSpec>& parameterSpecs() {
       {"min_calibration_range", &P::min_calibration_range, 0, 1000, {}},
       {"calibration_min_pca_eigenvalue", &P::calibration_min_pca_eigenvalue, 0, 1000, {}},
       {"calibration_min_distance_between_frames", &P::calibration_min_distance_between_frames, 0, 10000, {}},
+      {"calibration_frame_ranking", &P::calibration_frame_ranking, 0, 0, {"information", "pca"}},
       {"calibration_eval_max_corr_distance", &P::calibration_eval_max_corr_distance, 1e-3, 10, {}},
       {"solver_iterations", &P::solver_iterations, 1, 100000, {}},
       {"max_corr_dist_coarse", &P::max_corr_dist_coarse, 1e-3, 100, {}},

@@ -50,27 +50,45 @@ Selection selectFrames(const std::vector<SelectionCandidate>& candidates,
       pool.push_back(&c);
     }
   }
-  std::sort(pool.begin(), pool.end(), [](const SelectionCandidate* a, const SelectionCandidate* b) {
-    return a->information != b->information ? a->information > b->information : a->id < b->id;
-  });
-
-  std::vector<const SelectionCandidate*> chosen;
-  for (const SelectionCandidate* c : pool) {
-    if (int(chosen.size()) >= params.lidar_calibration_max_frames) {
-      result.rejected.push_back({c->id, "frame budget full (lidar_calibration_max_frames = " +
-                                            std::to_string(params.lidar_calibration_max_frames) + ")"});
-      continue;
+  const bool by_planes = params.calibration_frame_ranking != "pca";
+  registration::PointToPlaneInformation chosen_planes;  // summed over the chosen frames
+  // The rank of a candidate as the next frame; higher first, then by PCA information, then by id.
+  auto rank = [&](const SelectionCandidate* c) {
+    if (!by_planes) return 0.0;
+    registration::PointToPlaneInformation with = chosen_planes;
+    with += c->planes;
+    return with.weakestRelative();
+  };
+  while (!pool.empty()) {
+    if (int(result.selected.size()) >= params.lidar_calibration_max_frames) {
+      for (const SelectionCandidate* c : pool)
+        result.rejected.push_back({c->id, "frame budget full (lidar_calibration_max_frames = " +
+                                              std::to_string(params.lidar_calibration_max_frames) + ")"});
+      break;
     }
-    const auto too_close = std::find_if(chosen.begin(), chosen.end(), [&](const SelectionCandidate* s) {
-      return std::abs(s->path_length - c->path_length) < params.calibration_min_distance_between_frames;
-    });
-    if (too_close != chosen.end()) {
-      result.rejected.push_back({c->id, "only " + fmt(std::abs((*too_close)->path_length - c->path_length)) +
-                                            " m of path from selected frame " + std::to_string((*too_close)->id)});
-      continue;
+    const SelectionCandidate* best = nullptr;
+    double best_rank = 0.0;
+    for (const SelectionCandidate* c : pool) {
+      const double r = rank(c);
+      if (best == nullptr || r > best_rank ||
+          (r == best_rank && (c->information > best->information ||
+                              (c->information == best->information && c->id < best->id)))) {
+        best = c;
+        best_rank = r;
+      }
     }
-    chosen.push_back(c);
-    result.selected.push_back(c->id);
+    result.selected.push_back(best->id);
+    chosen_planes += best->planes;
+    std::vector<const SelectionCandidate*> rest;
+    for (const SelectionCandidate* c : pool) {
+      if (c == best) continue;
+      const double gap = std::abs(best->path_length - c->path_length);
+      if (gap < params.calibration_min_distance_between_frames)
+        result.rejected.push_back({c->id, "only " + fmt(gap) + " m of path from selected frame " + std::to_string(best->id)});
+      else
+        rest.push_back(c);
+    }
+    pool = std::move(rest);
   }
   return result;
 }

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "rigcal/pipeline/calibration_crop.hpp"
+#include "rigcal/pipeline/frame_information.hpp"
 #include "rigcal/pipeline/frame_selector.hpp"
 
 namespace rigcal::pipeline {
@@ -91,6 +92,7 @@ PairingLane::Step PairingLane::pairNext(const MappingView& view, std::vector<Can
                             std::to_string(params_.min_calibration_pointcloud_size);
     } else {
       c.information = pcaInformation(*cropped);
+      if (params_.calibration_frame_ranking != "pca") c.planes = frameInformation(*cropped);
       c.deskewed = std::move(cropped);
     }
   }

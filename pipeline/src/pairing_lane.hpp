@@ -14,6 +14,7 @@
 #include "rigcal/config/parameters.hpp"
 #include "rigcal/core/scan.hpp"
 #include "rigcal/pipeline/pairing.hpp"
+#include "rigcal/registration/point_to_plane_information.hpp"
 
 namespace rigcal::pipeline {
 
@@ -29,7 +30,8 @@ struct CandidateMessage {
   int lane = 0;
   Pairing pairing;
   std::shared_ptr<const Scan> raw, deskewed;  // deskewed: cropped, as stored in the dataset
-  double information = 0.0;
+  double information = 0.0;                   // pcaInformation() of deskewed
+  registration::PointToPlaneInformation planes;  // frameInformation() of deskewed (ranking "information")
   int keyframe_index = 0;
   double path_length = 0.0;
   std::size_t window_begin = 0, window_end = 0;  // stored frames [begin, end] of the dense window

@@ -39,7 +39,7 @@ void SelectionLane::reselect() {
   std::vector<SelectionCandidate> pool;
   for (std::size_t id = 0; id < records_.size(); ++id) {
     const CandidateMessage& c = records_[id].c;
-    if (c.pairing.accepted) pool.push_back({id, c.keyframe_index, c.path_length, c.information});
+    if (c.pairing.accepted) pool.push_back({id, c.keyframe_index, c.path_length, c.information, c.planes});
   }
   selection_ = selectFrames(pool, lost_keyframes_, params_);
   // Too flat or near a lost keyframe stays so: those candidates' clouds can go.

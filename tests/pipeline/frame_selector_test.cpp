@@ -26,7 +26,7 @@ TEST(FrameSelector, ExcludesLostNeighbourhoodFlatFramesSpacingAndBudget) {
   config::Parameters p;
   p.lidar_calibration_max_frames = 3;
   std::vector<SelectionCandidate> c;
-  for (int k = 0; k < 40; ++k) c.push_back({std::size_t(k), k, 1.0 * k, 0.3 + 0.01 * (k % 7)});
+  for (int k = 0; k < 40; ++k) c.push_back({std::size_t(k), k, 1.0 * k, 0.3 + 0.01 * (k % 7), {}});
   c[25].information = 0.1;  // too flat
   const Selection s = selectFrames(c, {5}, p);
   ASSERT_EQ(s.selected.size(), 3u);
@@ -45,7 +45,7 @@ TEST(FrameSelector, ExcludesLostNeighbourhoodFlatFramesSpacingAndBudget) {
 
 TEST(FrameSelector, DeterministicAndReportsShortfall) {
   config::Parameters p;
-  std::vector<SelectionCandidate> c = {{0, 0, 0.0, 0.5}, {1, 1, 1.0, 0.5}};
+  std::vector<SelectionCandidate> c = {{0, 0, 0.0, 0.5, {}}, {1, 1, 1.0, 0.5, {}}};
   const Selection a = selectFrames(c, {}, p), b = selectFrames(c, {}, p);
   EXPECT_EQ(a.selected, b.selected);
   EXPECT_EQ(a.selected, std::vector<std::size_t>{0});  // tie broken by id, 1 is too close

@@ -2,6 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "rigcal/registration/point_to_plane_information.hpp"
+
 namespace rigcal::calib {
 namespace {
 
@@ -37,8 +39,7 @@ RegistrationInformation registrationInformation(const registration::Target& targ
                                                 const registration::PointCloud& source, const Pose& T,
                                                 double max_distance, double weak_share) {
   RegistrationInformation info;
-  Eigen::Matrix3d Htt = Eigen::Matrix3d::Zero(), Hrr = Eigen::Matrix3d::Zero();
-  double lever_sq = 0.0;
+  registration::PointToPlaneInformation H;
   const Eigen::Vector3d t = T.translation();
   const auto& tn = target.cloud().normals;
   for (const auto& p : source.points) {
@@ -47,15 +48,11 @@ RegistrationInformation registrationInformation(const registration::Target& targ
     if (!target.tree().nearest(q, max_distance * max_distance, &nb)) continue;
     const Eigen::Vector3d n = tn[nb.index].head<3>();
     if (n.squaredNorm() < 0.5) continue;  // no normal estimated there
-    const Eigen::Vector3d arm = q.head<3>() - t;
-    const Eigen::Vector3d jr = arm.cross(n);
-    Htt += n * n.transpose();
-    Hrr += jr * jr.transpose();
-    lever_sq += arm.squaredNorm();
-    ++info.correspondences;
+    H.add(q.head<3>() - t, n);
   }
-  info.translation = decompose(Htt, double(info.correspondences), weak_share, {"x", "y", "z"});
-  info.rotation = decompose(Hrr, lever_sq, weak_share, {"roll", "pitch", "yaw"});
+  info.correspondences = H.correspondences;
+  info.translation = decompose(H.translation, double(H.correspondences), weak_share, {"x", "y", "z"});
+  info.rotation = decompose(H.rotation, H.lever_sq, weak_share, {"roll", "pitch", "yaw"});
   return info;
 }
 

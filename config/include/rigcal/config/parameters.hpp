@@ -50,6 +50,10 @@ struct Parameters {
   double min_calibration_range = 1.5;
   double calibration_min_pca_eigenvalue = 0.25;
   double calibration_min_distance_between_frames = 5.0;
+  // rigcal: the order in which calibration frames are chosen (and prepared under the deadline). "information":
+  // greedily, each next frame the one that most raises the weakest direction of the point-to-plane information
+  // of the frames chosen so far (frame_information.hpp); "pca": by pcaInformation() alone (upstream's).
+  std::string calibration_frame_ranking = "information";
   double calibration_eval_max_corr_distance = 0.1;
 
   // Calibration (registration ensemble)

@@ -1,0 +1,160 @@
+// Issue 19's unusual mounts through the real binaries, as a user meets them: `rigcal sim --scenario
+// yard-corners|yard-side` → `rigcal calibrate` (the preset's rig: guesses 0.3 m / 5° off, default parameters
+// plus calibrate_base_frame: true) → `rigcal compare` against truth.yaml.
+//   yard-corners: VLP-32C maps; VLP-16 corners yawed ±45° and pitched 15° down; a rear VLP-16 yawed 180°
+//                 and pitched 20° down (16 beams against a 32-beam map).
+//   yard-side:    OS1-64 maps; a VLP-32C rolled 90° and a VLP-16 rolled −90° (spin axes horizontal).
+// With the default deadline the result depends on the machine's load, so what is asserted is honesty: a
+// lidar called `ok` is within 1 cm / 0.05°, any other is `unverified` with the --deadline that would do.
+// With --deadline 60 every calibration lidar must be within the goal. Each preset is simulated once (~60-90 s)
+// and calibrated twice (~2 min each on a loaded machine): RIGCAL_LONG_TESTS=1 (Release) only; 8.1 min for all
+// four in one process at load 7-14 on 2 cores (the other helpers' builds).
+// Measured there (error cm / deg, frames registered / selected, registrations):
+//   default deadline  yard-corners  corner_left 0.44 / 0.018 1/4 5, corner_right 0.41 / 0.033 1/3 5, rear
+//                                   0.97 / 0.093 1/4 5: all unverified (suggested --deadline 30-50)
+//                     yard-side     side_left 0.45 / 0.022 2/5 6, side_right 0.43 / 0.049 4/4 10: both ok
+//   --deadline 60     yard-corners  0.33 / 0.005, 0.11 / 0.006, 0.18 / 0.006 (3-4 frames, 90-100 registrations)
+//                     yard-side     side_left 0.09 / 0.014 5/5 93, side_right 0.57 / 0.031 4/4 397
+// With calibration_frame_ranking: pca instead, yard-side side_left at --deadline 60 was called ok 4.46 cm off
+// (its frames disagreed by 43 cm; the verdict's tolerance is being fixed on main).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "calibrate_chain.hpp"
+#include "test_data.hpp"
+
+namespace rigcal::test {
+namespace {
+
+struct LidarError {
+  double cm = -1, deg = -1;
+};
+
+/// `rigcal compare`'s "error X cm Y deg" of each T_<mapping>_<sensor> block, by sensor.
+std::map<std::string, LidarError> lidarErrors(const std::string& compare_out, const nlohmann::json& lidars) {
+  std::map<std::string, LidarError> errors;
+  std::istringstream in(compare_out);
+  std::string line, block;
+  while (std::getline(in, line)) {
+    if (line.rfind("T_", 0) == 0) block = line.substr(0, line.find(' '));
+    const auto at = line.find(" error ");
+    if (at == std::string::npos || block.empty()) continue;
+    for (const auto& l : lidars) {
+      const std::string sensor = l["sensor"].get<std::string>();
+      if (block.size() > sensor.size() && block.compare(block.size() - sensor.size(), sensor.size(), sensor) == 0 &&
+          block[block.size() - sensor.size() - 1] == '_') {
+        std::istringstream nums(line.substr(at + 7));
+        std::string unit;
+        LidarError e;
+        nums >> e.cm >> unit >> e.deg;
+        errors[sensor] = e;
+      }
+    }
+  }
+  return errors;
+}
+
+/// The preset simulated once per test binary run (both tests of a preset share it).
+const std::filesystem::path& simulated(const std::string& preset) {
+  static std::map<std::string, std::unique_ptr<TempDir>> dirs;
+  auto& d = dirs[preset];
+  if (!d) {
+    d = std::make_unique<TempDir>();
+    double seconds = 0;
+    simulate(preset, *d / "sim", &seconds);
+    std::printf("%s: sim %.1f s\n", preset.c_str(), seconds);
+  }
+  static std::map<std::string, std::filesystem::path> paths;
+  return paths[preset] = *d / "sim";
+}
+
+/// calibrate (with `extra` arguments) → compare; every lidar's verdict, frames, registrations and error printed.
+struct Calibrated {
+  int exit_code = -1;
+  nlohmann::json report;
+  std::map<std::string, LidarError> errors;
+};
+
+Calibrated calibrate(const std::string& preset, const std::vector<std::string>& extra, const TempDir& dir) {
+  Calibrated c;
+  const auto& sim = simulated(preset);
+  if (!std::filesystem::exists(sim / "recording.pcap")) {
+    ADD_FAILURE() << "rigcal sim --scenario " << preset << " failed";
+    return c;
+  }
+  const auto out = dir / "out";
+  const auto run = runRigcal(calibrateArgs(sim, out, extra));
+  c.exit_code = run.exit_code;
+  if (!std::filesystem::exists(out / "report.json")) {
+    ADD_FAILURE() << "no report.json: " << run.out << run.err;
+    return c;
+  }
+  c.report = readJson(out / "report.json");
+  const auto compared = compareWithTruth(sim, out, 1.0, 0.05);
+  c.errors = lidarErrors(compared.out, c.report["lidars"]);
+  for (const auto& l : c.report["lidars"]) {
+    const std::string sensor = l["sensor"].get<std::string>();
+    const auto& e = l.value("evidence", nlohmann::json::object());
+    std::printf("%s %-13s %-11s error %.3f cm %.4f deg  frames %d/%d  registrations %zu  inliers %.2f  %.1f s\n",
+                preset.c_str(), sensor.c_str(), l.value("verdict", "-").c_str(), c.errors[sensor].cm,
+                c.errors[sensor].deg, e.value("frames_registered", 0), e.value("frames_selected", 0),
+                l.value("registrations", nlohmann::json::array()).size(), e.value("inlier_ratio", 0.0),
+                l.value("seconds", 0.0));
+  }
+  return c;
+}
+
+class CalibrateYardLong : public ::testing::TestWithParam<const char*> {};
+
+// Never a wrong `ok`, whatever the load: ok → within the goal; otherwise unverified with a suggested deadline.
+TEST_P(CalibrateYardLong, UnderTheDefaultDeadlineOkMeansWithinTheGoal) {
+  if (!longTests()) GTEST_SKIP() << "long test: set RIGCAL_LONG_TESTS=1 (Release only)";
+  TempDir dir;
+  const Calibrated c = calibrate(GetParam(), {}, dir);
+  ASSERT_FALSE(c.report.is_null());
+  ASSERT_GE(c.report["lidars"].size(), 2u);
+  bool all_ok = true;
+  for (const auto& l : c.report["lidars"]) {
+    const std::string sensor = l["sensor"].get<std::string>();
+    ASSERT_TRUE(c.errors.count(sensor)) << sensor << " missing from compare's output";
+    const LidarError e = c.errors.at(sensor);
+    all_ok = all_ok && l.value("verdict", "") == "ok";
+    if (l.value("verdict", "") == "ok") {
+      EXPECT_LT(e.cm, 1.0) << sensor << " is called ok off the goal";
+      EXPECT_LT(e.deg, 0.05) << sensor << " is called ok off the goal";
+    } else {
+      EXPECT_EQ(l.value("verdict", ""), "unverified") << sensor;
+      EXPECT_GT(l["evidence"].value("suggested_deadline_s", 0.0), 0.0) << sensor << ": say which --deadline would do";
+    }
+  }
+  EXPECT_EQ(c.exit_code, all_ok ? 0 : 6) << "exit 6 (unverified) unless every lidar is ok";
+}
+
+// Time enough (what the unverified runs suggest): every calibration lidar within 1 cm / 0.05°, and ok.
+TEST_P(CalibrateYardLong, WithALongDeadlineEveryLidarWithinTheGoal) {
+  if (!longTests()) GTEST_SKIP() << "long test: set RIGCAL_LONG_TESTS=1 (Release only)";
+  TempDir dir;
+  const Calibrated c = calibrate(GetParam(), {"--deadline", "60"}, dir);
+  ASSERT_FALSE(c.report.is_null());
+  for (const auto& l : c.report["lidars"]) {
+    const std::string sensor = l["sensor"].get<std::string>();
+    ASSERT_TRUE(c.errors.count(sensor)) << sensor << " missing from compare's output";
+    EXPECT_LT(c.errors.at(sensor).cm, 1.0) << sensor;
+    EXPECT_LT(c.errors.at(sensor).deg, 0.05) << sensor;
+    EXPECT_EQ(l.value("verdict", ""), "ok") << sensor << ": " << l.value("doubt", "");
+  }
+  EXPECT_EQ(c.exit_code, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Yard, CalibrateYardLong, ::testing::Values("yard-corners", "yard-side"),
+                         [](const ::testing::TestParamInfo<const char*>& p) {
+                           return std::string(p.param) == "yard-corners" ? "Corners" : "Side";
+                         });
+
+}  // namespace
+}  // namespace rigcal::test
