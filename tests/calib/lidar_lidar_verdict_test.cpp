@@ -77,8 +77,18 @@ TEST(LidarLidarVerdict, FramesScatteringBeyondTheGoalAreUnverified) {
   EXPECT_EQ(r.verdict, Verdict::kUnverified);
   EXPECT_EQ(r.evidence.frames_agreeing, 4u);
   EXPECT_NEAR(r.evidence.frame_uncertainty_m, 2.0 * std::sqrt(0.0017) / 4.0, 1e-9);
-  EXPECT_NE(r.doubt.find("its 4 frames scatter about it by ± 2.06 cm"), std::string::npos) << r.doubt;
+  EXPECT_NE(r.doubt.find("its 4 agreeing frames scatter about it by ± 2.06 cm"), std::string::npos) << r.doubt;
   EXPECT_NE(r.doubt.find("--deadline 20"), std::string::npos) << r.doubt;
+}
+
+// One frame 30 cm off among five that agree within 2 mm: an outlier the majority outvotes, not scatter.
+TEST(LidarLidarVerdict, AnOutlierFrameIsOutvotedNotCountedAsScatter) {
+  auto r = resultWithFrames({1.0, 1.002, 0.998, 1.001, 0.999, 1.3});
+  judgeLidarLidar(r, 6, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.doubt;
+  EXPECT_EQ(r.evidence.frames_agreeing, 5u);
+  EXPECT_LT(r.evidence.frame_uncertainty_m, 0.002);
+  EXPECT_NEAR(r.evidence.frame_spread_m, 0.3, 1e-9);
 }
 
 // The same 1.5 cm scatter over sixteen frames narrows to ± 0.75 cm: within the goal, ok.

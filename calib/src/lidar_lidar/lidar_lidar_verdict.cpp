@@ -64,11 +64,12 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
     const Distance d = distance(r.candidates[run->result], r.T_mapping_calib);
     e.frame_spread_m = std::max(e.frame_spread_m, d.m);
     e.frame_spread_deg = std::max(e.frame_spread_deg, d.deg);
+    if (!near(d)) continue;  // an outlier frame is judged by the majority rule below, not as scatter
+    ++e.frames_agreeing;
     sum_sq_m += d.m * d.m;
     sum_sq_deg += d.deg * d.deg;
-    if (near(d)) ++e.frames_agreeing;
   }
-  if (const double n = double(frame_best.size()); n >= 2) {
+  if (const double n = double(e.frames_agreeing); n >= 2) {
     // rms / sqrt(n) = sqrt(sum / n²): the standard error of the frames' mean about the final result.
     e.frame_uncertainty_m = 2.0 * std::sqrt(sum_sq_m) / n;
     e.frame_uncertainty_deg = 2.0 * std::sqrt(sum_sq_deg) / n;
@@ -92,7 +93,7 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
     clause() << disagreeing << " of " << e.frames_registered << " frames disagree (spread " << 100.0 * e.frame_spread_m
              << " cm, " << e.frame_spread_deg << " deg)";
   if (e.frame_uncertainty_m > opt.goal_m || e.frame_uncertainty_deg > opt.goal_deg) {
-    clause() << "its " << e.frames_registered << " frames scatter about it by ± " << 100.0 * e.frame_uncertainty_m
+    clause() << "its " << e.frames_agreeing << " agreeing frames scatter about it by ± " << 100.0 * e.frame_uncertainty_m
              << " cm, " << std::setprecision(3) << e.frame_uncertainty_deg << std::setprecision(2)
              << " deg (two standard errors; the goal is " << 100.0 * opt.goal_m << " cm, " << opt.goal_deg
              << " deg)";

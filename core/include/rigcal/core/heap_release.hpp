@@ -6,9 +6,8 @@
 // Both calls are no-ops where the C library is not glibc.
 namespace rigcal {
 
-/// From now on blocks of 1 MiB and more (scans, clouds, targets) are mmapped and unmapped when freed (a
-/// fixed threshold, not the one glibc raises as it sees large frees), and the threads share at most two
-/// arenas (one per core of the 2-core target). Call once, before the work starts its threads.
+/// From now on the threads share at most two malloc arenas (one per core of the 2-core target) instead of
+/// one each. Call once, before the work starts its threads.
 void limitHeapRetention();
 
 /// Gives the freed pages of every malloc arena back to the system (malloc_trim): where a large piece of

@@ -64,7 +64,8 @@ struct LidarLidarEvidence {
   double frame_spread_m = 0.0;       // largest distance of a frame's own best result from the final one
   double frame_spread_deg = 0.0;
   // How far the final result may be off, judged by how its frames scatter about it: two standard errors
-  // (2 · rms / sqrt(n)) over the n frames' own best results; 0 with fewer than two frames.
+  // (2 · rms / sqrt(n)) over the own best results of the n frames that agree with it (an outlier frame counts
+  // against the result as a disagreeing frame instead); 0 with fewer than two.
   double frame_uncertainty_m = 0.0;
   double frame_uncertainty_deg = 0.0;
   std::vector<std::string> registrators_agreeing;  // registrators with a result near the final one
