@@ -12,21 +12,14 @@
 #include "rigcal/core/atomic_file.hpp"
 #include "rigcal/registration/icp.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
+#include "scan_points.hpp"
 
 namespace rigcal::calib {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using detail::finitePoints;
 
-std::vector<Eigen::Vector3d> finitePoints(const Scan& s) {
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    const Eigen::Vector3d p(s.x[i], s.y[i], s.z[i]);
-    if (p.allFinite()) out.push_back(p);
-  }
-  return out;
-}
+using Clock = std::chrono::steady_clock;
 
 // The pair as the lidar-lidar calibration's input: the target is the only mapping cloud (at a keyframe
 // with the identity pose), the source the only calibration frame, taken while standing (no deskew).

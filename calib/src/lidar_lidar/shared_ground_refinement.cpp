@@ -14,9 +14,12 @@
 #include "rigcal/calib/base_lidar/ground_plane.hpp"
 #include "rigcal/registration/target.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
+#include "scan_points.hpp"
 
 namespace rigcal::calib {
 namespace {
+
+using detail::finitePoints;
 
 // m: a plane with this many points further below it is not the floor (noise and a 2.5 cm fit band stay
 // well inside)
@@ -27,16 +30,6 @@ struct Floor {
   double d = 0.0;                                     // normal·p + d = 0
   std::size_t points = 0;
 };
-
-std::vector<Eigen::Vector3d> finitePoints(const Scan& s) {
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    const Eigen::Vector3d p(s.x[i], s.y[i], s.z[i]);
-    if (p.allFinite()) out.push_back(p);
-  }
-  return out;
-}
 
 // Total least squares through the points within `band` of the plane (its smallest-variance direction).
 bool refitPlane(const std::vector<Eigen::Vector3d>& pts, double band, Floor& f) {
