@@ -66,6 +66,13 @@ double secondsLeft(const registration::Deadline& deadline) {
   return std::chrono::duration<double>(deadline.when() - registration::Deadline::Clock::now()).count();
 }
 
+registration::Deadline earlierBy(const registration::Deadline& deadline, double seconds) {
+  if (deadline.when() == registration::Deadline::Clock::time_point::max()) return deadline;
+  const auto reserve = std::chrono::duration_cast<registration::Deadline::Clock::duration>(
+      std::chrono::duration<double>(seconds));
+  return registration::Deadline::at(deadline.when() - reserve, deadline.token());
+}
+
 bool fits(const registration::Deadline& deadline, double seconds) {
   return !deadline.expired() && secondsLeft(deadline) >= seconds;
 }

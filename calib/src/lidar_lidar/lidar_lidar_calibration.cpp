@@ -1,7 +1,6 @@
 #include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <exception>
 #include <iomanip>
 #include <sstream>
@@ -49,15 +48,11 @@ LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset
     out.deadline_share_s = std::max(0.0, secondsLeft(deadline));
   out.failure = validateDataset(dataset, params);
   // The trajectory clock estimate's time comes off the end of the calibration's (its exhaustive ensemble).
-  registration::Deadline calibration_deadline = deadline;
-  if (options.trajectory_clock && deadline.when() != registration::Deadline::Clock::time_point::max()) {
-    const double reserve =
-        std::min(options.trajectory_clock_max_s, options.trajectory_clock_share * std::max(0.0, secondsLeft(deadline)));
-    calibration_deadline = registration::Deadline::at(
-        deadline.when() - std::chrono::duration_cast<registration::Deadline::Clock::duration>(
-                              std::chrono::duration<double>(reserve)),
-        deadline.token());
-  }
+  const registration::Deadline calibration_deadline =
+      options.trajectory_clock
+          ? earlierBy(deadline, std::min(options.trajectory_clock_max_s,
+                                         options.trajectory_clock_share * std::max(0.0, secondsLeft(deadline))))
+          : deadline;
   if (out.failure.empty()) {
     try {
       detail::Calibrator calibrator(dataset, params, calibration_deadline, options, out);

@@ -127,12 +127,7 @@ CalibrationScore Calibrator::score(const Pose& T) {
   return scoreAllFrames(score_pairs_, T, params_.calibration_eval_max_corr_distance, 1, opt_.num_threads);
 }
 
-Deadline Calibrator::registrationDeadline() const {
-  if (deadline_.when() == Deadline::Clock::time_point::max()) return deadline_;
-  const auto reserve = std::chrono::duration_cast<Deadline::Clock::duration>(
-      std::chrono::duration<double>(2.5 * score_seconds_ + 0.01));
-  return Deadline::at(deadline_.when() - reserve, deadline_.token());
-}
+Deadline Calibrator::registrationDeadline() const { return earlierBy(deadline_, 2.5 * score_seconds_ + 0.01); }
 
 bool Calibrator::consider(const Pose& T, RegistratorRun* run) {
   if (!finitePose(T) || !fits(deadline_, score_seconds_)) return false;

@@ -57,4 +57,8 @@ bool fits(const registration::Deadline& deadline, double seconds);
 /// Seconds left before `deadline` (a large number without one).
 double secondsLeft(const registration::Deadline& deadline);
 
+/// The same deadline `seconds` earlier (same cancel token), leaving that much for work after it; no limit stays
+/// no limit.
+registration::Deadline earlierBy(const registration::Deadline& deadline, double seconds);
+
 }  // namespace rigcal::calib
