@@ -22,6 +22,7 @@
 #include "rigcal/calib/lidar_lidar/static_calibration.hpp"
 #include "rigcal/calib/outputs/calibration_outputs.hpp"
 #include "rigcal/calib/outputs/summary_table.hpp"
+#include "rigcal/core/text_format.hpp"
 
 namespace rigcal::app {
 namespace {
@@ -29,12 +30,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-std::string fixed(double v, int digits) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(digits) << v;
-  return o.str();
-}
 
 }  // namespace
 

@@ -19,6 +19,7 @@
 #include "rigcal/shm/liveness.hpp"
 #include "rigcal/shm/ring_inspect.hpp"
 #include "rigcal/shm/ring_segment.hpp"
+#include "rigcal/core/text_format.hpp"
 
 namespace rigcal::app {
 
@@ -32,12 +33,6 @@ struct MonitorOptions {
   bool once = false;
   double interval = 1.0;
 };
-
-std::string fixed(double v, int decimals) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(decimals) << v;
-  return s.str();
-}
 
 std::string human(double v) {
   if (v >= 1e6) return fixed(v / 1e6, 2) + "M";

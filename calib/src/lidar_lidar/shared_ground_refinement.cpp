@@ -14,6 +14,7 @@
 #include "rigcal/calib/base_lidar/ground_plane.hpp"
 #include "rigcal/registration/target.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
+#include "rigcal/core/text_format.hpp"
 #include "scan_points.hpp"
 
 namespace rigcal::calib {
@@ -105,12 +106,6 @@ std::optional<Floor> fitFloor(const std::vector<Eigen::Vector3d>& points, const 
   return std::nullopt;
 }
 
-
-std::string fixed(double v, int digits) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(digits) << v;
-  return o.str();
-}
 
 }  // namespace
 

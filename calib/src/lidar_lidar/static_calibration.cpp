@@ -13,6 +13,7 @@
 #include "rigcal/registration/icp.hpp"
 #include "rigcal/registration/target.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
+#include "rigcal/core/text_format.hpp"
 
 namespace rigcal::calib {
 namespace {
@@ -52,12 +53,6 @@ pipeline::CalibrationDataset staticDataset(const std::string& mapping, const std
   d.frames = {f};
   d.budget_full = true;
   return d;
-}
-
-std::string fixed(double v, int digits) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(digits) << v;
-  return o.str();
 }
 
 // The static verdict: the lidar-lidar rules with the accumulated cloud as the one frame there is, then the
