@@ -28,7 +28,10 @@ registration::PointToPlaneInformation frameInformation(const Scan& cloud, const 
       const Eigen::Vector3d d = thinned.points[nb[j].index].head<3>() - mean;
       cov += d * d.transpose();
     }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    // The closed form for 3x3 (several times cheaper than the iterative solver; its eigenvalues are accurate
+    // far beyond the thresholds below).
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(cov);
     const Eigen::Vector3d ev = es.eigenvalues();  // ascending
     if (ev(2) <= 0 || ev(0) > options.max_flatness * ev(1) || ev(1) < options.min_planarity * ev(2)) continue;
     info.add(p.head<3>(), es.eigenvectors().col(0));
