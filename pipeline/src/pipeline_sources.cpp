@@ -146,7 +146,7 @@ void Pipeline::Impl::readRing(std::size_t r) {
         live = true;
         last_publish_ns = meta.publish_ns;
         // The writer's malformed packets as they happen, as an in-process driver's are shown.
-        tally.update(meta.driver, restarted || (epoch != 0 && meta.epoch != epoch));
+        tally.update(meta.driver, meta.writer_scan, restarted || (epoch != 0 && meta.epoch != epoch));
         epoch = meta.epoch;
         (r == 0 ? mapping_malformed_packets : lanes[r - 1]->malformed_packets)
             .store(tally.totals().malformed, std::memory_order_relaxed);

@@ -4,19 +4,22 @@ namespace rigcal::pipeline::detail {
 
 namespace {
 
-void add(RingInputTotals& sum, const shm::DriverTally& t) {
-  sum.packets += t.packets;
-  sum.malformed += t.malformed;
-  sum.late_dropped += t.late_dropped;
-  sum.reordered += t.reordered;
-  sum.foreign += t.foreign;
+// Adds what `writer` counted after `baseline` (both its running totals, which only grow).
+void add(RingInputTotals& sum, const shm::DriverTally& writer, const shm::DriverTally& baseline) {
+  const auto since = [](std::uint64_t now, std::uint64_t then) { return now >= then ? now - then : 0; };
+  sum.packets += since(writer.packets, baseline.packets);
+  sum.malformed += since(writer.malformed, baseline.malformed);
+  sum.late_dropped += since(writer.late_dropped, baseline.late_dropped);
+  sum.reordered += since(writer.reordered, baseline.reordered);
+  sum.foreign += since(writer.foreign, baseline.foreign);
 }
 
 }  // namespace
 
-void RingInputTally::update(const shm::DriverTally& tally, bool new_writer) {
+void RingInputTally::update(const shm::DriverTally& tally, std::uint64_t writer_scan, bool new_writer) {
   std::lock_guard lock(mutex_);
-  if (new_writer && seen_) add(earlier_writers_, current_);
+  if (new_writer && seen_) add(earlier_writers_, current_, baseline_);
+  if (new_writer || !seen_) baseline_ = writer_scan == 0 ? shm::DriverTally{} : tally;
   current_ = tally;
   seen_ = true;
 }
@@ -24,7 +27,7 @@ void RingInputTally::update(const shm::DriverTally& tally, bool new_writer) {
 RingInputTotals RingInputTally::totals() const {
   std::lock_guard lock(mutex_);
   RingInputTotals t = earlier_writers_;
-  add(t, current_);
+  add(t, current_, baseline_);
   return t;
 }
 

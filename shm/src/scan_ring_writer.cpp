@@ -167,7 +167,7 @@ bool ScanRingWriter::publish(const Scan& scan, const DriverTally& tally) {
     m.view.header().oversize_drops.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
-  publishScan(m.view, scan, m.epoch, tally);
+  publishScan(m.view, scan, m.epoch, tally, m.stats.published);
   ++m.stats.published;
   m.stats.points += scan.size();
   m.stats.bytes += payloadBytes(scan.size());

@@ -116,13 +116,14 @@ TEST(RingProtocol, TheDriversTallyRoundTripsAndIsChecksummed) {
   Scan in;
   test::fillPattern(in, 7, test::patternPoints(7, 100));
   const DriverTally tally{123456789012ULL, 5, 6, 7, 8};
-  publishScan(view, in, 1, tally);
+  publishScan(view, in, 1, tally, 9);
   std::uint64_t next = 0;
   Scan out;
   ScanMeta meta;
   ReadCounters counters;
   ASSERT_EQ(readNext(view, next, out, &meta, counters), ReadOutcome::kScan);
   EXPECT_EQ(meta.driver, tally);
+  EXPECT_EQ(meta.writer_scan, 9u);
 
   publishScan(view, in, 1, tally);
   view.slotHeader(1).tally_malformed.store(50);  // as a stray write would

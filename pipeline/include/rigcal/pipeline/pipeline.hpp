@@ -194,7 +194,8 @@ class Pipeline {
   [[nodiscard]] MappingResult mapping(bool with_dense_cloud = false) const;
   [[nodiscard]] std::vector<Shortfall> shortfalls() const;  // after finish()
   /// After finish(); empty for kInProcess. For kShm, one per ring as its driver process counted (the tally
-  /// in the newest scan read, summed over restarted writers; no clock lag, last error or capture warning).
+  /// in the newest scan read, from the first scan read if the driver was already running, summed over
+  /// restarted writers; no clock lag, last error or capture warning).
   [[nodiscard]] std::vector<SensorInput> inputs() const;
 
  private:

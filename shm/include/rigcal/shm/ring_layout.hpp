@@ -88,6 +88,7 @@ struct alignas(kCacheLine) SlotHeader {
   std::atomic<std::uint32_t> tally_late_dropped;
   std::atomic<std::uint32_t> tally_reordered;
   std::atomic<std::uint32_t> tally_foreign;
+  std::atomic<std::uint64_t> writer_scan;  // scans this writer published before this one (0: its first)
 };
 
 /// Where each point array sits inside a slot, for a given capacity. Arrays start on cache lines.
@@ -160,7 +161,7 @@ constexpr std::uint64_t computeLayoutHash() {
       offsetof(SlotHeader, point_count), offsetof(SlotHeader, missing_packets),
       offsetof(SlotHeader, tally_packets), offsetof(SlotHeader, tally_malformed),
       offsetof(SlotHeader, tally_late_dropped), offsetof(SlotHeader, tally_reordered),
-      offsetof(SlotHeader, tally_foreign),
+      offsetof(SlotHeader, tally_foreign), offsetof(SlotHeader, writer_scan),
       slotGeometry(1000).offset_ns, slotGeometry(1000).return_index, slotGeometry(1000).slot_bytes,
   };
   std::uint64_t h = 0xcbf29ce484222325ULL;

@@ -26,6 +26,8 @@ struct ScanMeta {
   std::uint64_t epoch = 0;       // epoch of the writer that published it
   std::int64_t publish_ns = 0;   // CLOCK_MONOTONIC when it was complete in its slot, just before it became visible
   DriverTally driver;            // its writer's running tally when it published the scan
+  std::uint64_t writer_scan = 0;  // scans its writer published before it: 0 = the writer's first, so the
+                                  // tally covers everything that writer counted
 };
 
 /// A mapped ring: header and slots, wherever this process mapped them.
@@ -69,12 +71,13 @@ HeaderState checkHeader(const void* base, std::size_t bytes, const std::string& 
 
 /// Publishes `scan` (which must fit) with its writer's `tally` as ring index write_index and wakes
 /// sleeping readers; returns the index.
-std::uint64_t publishScan(const RingView& ring, const Scan& scan, std::uint64_t epoch, const DriverTally& tally = {});
+std::uint64_t publishScan(const RingView& ring, const Scan& scan, std::uint64_t epoch, const DriverTally& tally = {},
+                          std::uint64_t writer_scan = 0);
 
 /// The steps of publishScan, exposed so a test can stop between them (a writer dying mid-write).
 std::uint64_t beginPublish(const RingView& ring);  // seq odd; returns the index being written
 void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch,
-                  const DriverTally& tally = {});
+                  const DriverTally& tally = {}, std::uint64_t writer_scan = 0);
 void commitPublish(const RingView& ring, std::uint64_t index, const Scan& scan);  // seq even, index+1, wake
 
 /// Bumps the futex word and wakes every sleeping reader (after a publish, on close, after a takeover).
