@@ -7,6 +7,7 @@
 #include "rigcal/bag/bag_error.hpp"
 #include "rigcal/bag/byte_cursor.hpp"
 #include "rigcal/bag/crc32.hpp"
+#include "prefetch_thread.hpp"
 
 namespace rigcal::bag {
 
@@ -213,19 +214,18 @@ void McapFile::scanLinearly() {
     warning_ += " (using the " + std::to_string(refs_.size()) + " chunks before the cut)";
 }
 
-void McapFile::load(const Ref& ref, std::size_t order) {
-  std::unique_ptr<Loaded> chunk;
-  if (spare_.empty()) {
-    chunk = std::make_unique<Loaded>();
-  } else {
-    chunk = std::move(spare_.back());
-    spare_.pop_back();
-    chunk->entries.clear();
-    chunk->next = 0;
-  }
-  chunk->order = order;
+std::unique_ptr<McapFile::Loaded> McapFile::spareChunk() {
+  if (spare_.empty()) return std::make_unique<Loaded>();
+  std::unique_ptr<Loaded> chunk = std::move(spare_.back());
+  spare_.pop_back();
+  chunk->entries.clear();
+  chunk->next = 0;
+  return chunk;
+}
+
+void McapFile::fetch(const Ref& ref, Loaded& chunk, mcap::ChunkDecompressor& decompressor) const {
   const std::string what = path_.string() + ": chunk at offset " + std::to_string(ref.offset);
-  const auto record = chunk->record.resize(std::size_t(ref.length));
+  const auto record = chunk.record.resize(std::size_t(ref.length));
   if (ref.length < mcap::kRecordHeaderSize || file_.readAt(ref.offset, record) != ref.length)
     throw BagError(what + ": record of " + std::to_string(ref.length) + " bytes cut short by the end of the file");
   const auto h = parseHeader(std::span<const std::uint8_t, mcap::kRecordHeaderSize>(record.data(), 9));
@@ -233,20 +233,50 @@ void McapFile::load(const Ref& ref, std::size_t order) {
   if (h.length != body.size())
     throw BagError(what + ": record length " + std::to_string(h.length) + " disagrees with the index (" +
                    std::to_string(body.size()) + ")");
-  if (h.opcode == op(Opcode::kChunk)) {
-    const auto parsed = mcap::parseChunk(body, what);
-    chunk->records = decompressor_.inflate(parsed, chunk->inflated, what);
+  chunk.opcode = h.opcode;
+  if (h.opcode == op(Opcode::kChunk)) chunk.records = decompressor.inflate(mcap::parseChunk(body, what), chunk.inflated, what);
+  else if (h.opcode == op(Opcode::kMessage)) chunk.records = body;
+  else throw BagError(what + ": expected a chunk, found opcode " + std::to_string(h.opcode));
+}
+
+void McapFile::prefetch(std::size_t order) {
+  if (ahead_ || order >= refs_.size()) return;
+  if (!prefetch_) prefetch_ = std::make_unique<PrefetchThread>();
+  ahead_ = spareChunk();
+  ahead_order_ = order;
+  prefetch_->submit([this, ref = refs_[order], chunk = ahead_.get()] { fetch(ref, *chunk, ahead_decompressor_); });
+}
+
+void McapFile::load(const Ref& ref, std::size_t order) {
+  std::unique_ptr<Loaded> chunk;
+  if (ahead_ && ahead_order_ == order) {
+    std::unique_ptr<Loaded> fetched = std::move(ahead_);
+    prefetch_->wait();  // rethrows the chunk's error, here where the reader reaches it
+    chunk = std::move(fetched);
+  } else {
+    if (ahead_) {  // not the chunk asked for (not expected: chunks load in order): let it finish, keep its buffers
+      try {
+        prefetch_->wait();
+      } catch (const std::exception&) {  // that chunk's error belongs to when it is loaded
+      }
+      spare_.push_back(std::move(ahead_));
+    }
+    chunk = spareChunk();
+    fetch(ref, *chunk, decompressor_);
+  }
+  chunk->order = order;
+  if (chunk->opcode == op(Opcode::kChunk)) {
+    const std::string what = path_.string() + ": chunk at offset " + std::to_string(ref.offset);
     indexRecords(chunk->records, what, &chunk->entries);
     std::stable_sort(chunk->entries.begin(), chunk->entries.end(),
                      [](const Entry& a, const Entry& b) { return a.log_time < b.log_time; });
-  } else if (h.opcode == op(Opcode::kMessage)) {
-    const auto m = mcap::parseMessage(body, where(ref.offset));
-    chunk->records = body;
-    chunk->entries.push_back({m.log_time, std::uint32_t(m.data.data() - body.data()), std::uint32_t(m.data.size()),
-                              channel_topic_.at(m.channel_id)});
   } else {
-    throw BagError(what + ": expected a chunk, found opcode " + std::to_string(h.opcode));
+    const auto m = mcap::parseMessage(chunk->records, where(ref.offset));
+    chunk->entries.push_back({m.log_time, std::uint32_t(m.data.data() - chunk->records.data()),
+                              std::uint32_t(m.data.size()), channel_topic_.at(m.channel_id)});
   }
+  // The next chunk is read and inflated while the caller decodes this one's messages.
+  prefetch(order + 1);
   if (chunk->entries.empty()) {
     spare_.push_back(std::move(chunk));
     return;

@@ -197,6 +197,20 @@ std::vector<SensorInput> Pipeline::inputs() const {
     in.clock_lag_sweeps = lag.sweeps;
     out.push_back(std::move(in));
   }
+  // Rings: what each sensor's driver process counted, as far as the scans read from its ring tell.
+  for (std::size_t r = 0; r < impl_->ring_tallies.size(); ++r) {
+    const RingInputTotals t = impl_->ring_tallies[r]->totals();
+    SensorInput in;
+    in.sensor = impl_->sensors[r];
+    in.packets = t.packets;
+    in.lost_packets = r == 0 ? impl_->mapping_lost_packets.load() : impl_->lanes[r - 1]->lost_packets.load();
+    in.malformed = t.malformed;
+    in.late_dropped = t.late_dropped;
+    in.reordered = t.reordered;
+    in.foreign_packets = t.foreign;
+    if (t.foreign > 0) in.foreign = "packets of another model on its port (its driver process names them)";
+    out.push_back(std::move(in));
+  }
   return out;
 }
 

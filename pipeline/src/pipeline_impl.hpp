@@ -16,6 +16,7 @@
 #include <stdexcept>
 
 #include "pairing_lane.hpp"
+#include "ring_input_tally.hpp"
 #include "selection_lane.hpp"
 #include "trajectory_buffer.hpp"
 #include "rigcal/pipeline/bounded_queue.hpp"
@@ -85,7 +86,7 @@ struct StageRecord {
 struct LaneCounters {
   std::atomic<std::uint64_t> scans{0}, candidates{0}, accepted{0}, selected{0};
   std::atomic<std::uint64_t> lost_packets{0};  // Scan::missing_packets summed: drivers and rings alike
-  std::atomic<std::uint64_t> malformed_packets{0};  // its in-process driver's count so far (rings carry none)
+  std::atomic<std::uint64_t> malformed_packets{0};  // its driver's count so far (in-process, or its ring's writer)
   std::atomic<bool> handed_over{false};
 };
 
@@ -148,6 +149,7 @@ struct Pipeline::Impl {
   std::vector<std::unique_ptr<SensorDriver>> drivers;
   std::vector<int> driver_sensor;  // sensor index of each driver
   std::vector<std::unique_ptr<shm::ScanRingReader>> readers;
+  std::vector<std::unique_ptr<RingInputTally>> ring_tallies;  // per reader: what its writers counted
   std::atomic<int> sources_running{0};
   std::atomic<int> live_writers{0};          // rings whose writer delivered and is not known gone
   std::atomic<bool> writers_gone{false};     // every ring writer seen is gone: the shm input ends

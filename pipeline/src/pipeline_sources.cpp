@@ -87,6 +87,7 @@ void Pipeline::Impl::setUpSources() {
       ro.name_prefix = options.shm_prefix;
       ro.start_at = realtime ? shm::ReaderOptions::StartAt::kNext : shm::ReaderOptions::StartAt::kOldest;
       readers.push_back(std::make_unique<shm::ScanRingReader>(ro));
+      ring_tallies.push_back(std::make_unique<RingInputTally>());
     }
   }
 }
@@ -121,6 +122,8 @@ void Pipeline::Impl::readRing(std::size_t r) {
   bool live = false;                 // this ring's writer is counted in live_writers
   std::int64_t last_publish_ns = 0;  // CLOCK_MONOTONIC of the last scan read, 0 before the first
   std::uint64_t restarts = 0;
+  std::uint64_t epoch = 0;  // of the last scan read
+  RingInputTally& tally = *ring_tallies[r];
   const auto writerGone = [&](const std::string& why, bool clean) {
     live = false;
     std::cerr << (clean ? "" : "warning: ") << "sensor '" << sensor << "': " << why << "\n";
@@ -142,6 +145,11 @@ void Pipeline::Impl::readRing(std::size_t r) {
         if (!live) ++live_writers;
         live = true;
         last_publish_ns = meta.publish_ns;
+        // The writer's malformed packets as they happen, as an in-process driver's are shown.
+        tally.update(meta.driver, meta.writer_scan, restarted || (epoch != 0 && meta.epoch != epoch));
+        epoch = meta.epoch;
+        (r == 0 ? mapping_malformed_packets : lanes[r - 1]->malformed_packets)
+            .store(tally.totals().malformed, std::memory_order_relaxed);
         ingest(Scan(scan), int(r), meta.publish_ns);
       } else if (st == shm::ReadStatus::kWriterGone && live) {
         const shm::WriterStatus status = reader.writerStatus();

@@ -29,11 +29,15 @@ std::string hex(std::uint64_t v) {
 
 /// Header fields that take part in the checksum, in this order, before the point arrays.
 void sumHeader(detail::Checksum& sum, std::uint64_t points, std::uint64_t sequence, std::int64_t stamp,
-               std::uint64_t missing) {
+               std::uint64_t missing, const DriverTally& tally, std::uint64_t writer_scan) {
   sum.add(points);
   sum.add(sequence);
   sum.add(static_cast<std::uint64_t>(stamp));
   sum.add(missing);
+  sum.add(tally.packets);
+  sum.add(std::uint64_t{tally.malformed} << 32 | tally.late_dropped);
+  sum.add(std::uint64_t{tally.reordered} << 32 | tally.foreign);
+  sum.add(writer_scan);
 }
 
 /// Copies the payload of `slot` into `out`; false if the point count is impossible or the checksum is off.
@@ -46,14 +50,23 @@ bool copyOut(const RingView& ring, std::uint64_t index, Scan& out, ScanMeta* met
   const std::uint64_t sequence = s.sensor_sequence.load(kAcquire);
   const std::int64_t stamp = s.stamp_ns.load(kAcquire);
   const std::uint32_t missing = s.missing_packets.load(kAcquire);
+  DriverTally tally;
+  tally.packets = s.tally_packets.load(kAcquire);
+  tally.malformed = s.tally_malformed.load(kAcquire);
+  tally.late_dropped = s.tally_late_dropped.load(kAcquire);
+  tally.reordered = s.tally_reordered.load(kAcquire);
+  tally.foreign = s.tally_foreign.load(kAcquire);
+  const std::uint64_t writer_scan = s.writer_scan.load(kAcquire);
   const std::uint64_t expected = s.checksum.load(kAcquire);
   if (meta) {
     meta->ring_index = index;
     meta->epoch = s.epoch.load(kAcquire);
     meta->publish_ns = s.publish_ns.load(kAcquire);
+    meta->driver = tally;
+    meta->writer_scan = writer_scan;
   }
   detail::Checksum sum;
-  sumHeader(sum, n, sequence, stamp, missing);
+  sumHeader(sum, n, sequence, stamp, missing, tally, writer_scan);
   // resize() stays within capacity once `out` has held a scan this large: no allocation in steady state.
   out.resize(n);
   std::byte* base = ring.slotBase(index);
@@ -164,12 +177,13 @@ std::uint64_t beginPublish(const RingView& ring) {
   return index;
 }
 
-void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch) {
+void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch,
+                  const DriverTally& tally, std::uint64_t writer_scan) {
   SlotHeader& s = ring.slotHeader(index);
   const SlotGeometry& g = ring.geometry();
   const auto n = static_cast<std::uint32_t>(scan.size());
   detail::Checksum sum;
-  sumHeader(sum, n, scan.sequence, scan.stamp_ns, scan.missing_packets);
+  sumHeader(sum, n, scan.sequence, scan.stamp_ns, scan.missing_packets, tally, writer_scan);
   std::byte* base = ring.slotBase(index);
   detail::copyToShared(base + g.x, scan.x.data(), 4u * n, sum);
   detail::copyToShared(base + g.y, scan.y.data(), 4u * n, sum);
@@ -182,6 +196,12 @@ void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, s
   s.sensor_sequence.store(scan.sequence, kRelease);
   s.stamp_ns.store(scan.stamp_ns, kRelease);
   s.missing_packets.store(scan.missing_packets, kRelease);
+  s.tally_packets.store(tally.packets, kRelease);
+  s.tally_malformed.store(tally.malformed, kRelease);
+  s.tally_late_dropped.store(tally.late_dropped, kRelease);
+  s.tally_reordered.store(tally.reordered, kRelease);
+  s.tally_foreign.store(tally.foreign, kRelease);
+  s.writer_scan.store(writer_scan, kRelease);
   s.epoch.store(epoch, kRelease);
   s.checksum.store(sum.value(), kRelease);
 }
@@ -210,9 +230,10 @@ void wakeReaders(const RingView& ring) {
   if (h.waiters.load(kSeqCst) != 0) futexWakeAll(h.futex_word);
 }
 
-std::uint64_t publishScan(const RingView& ring, const Scan& scan, std::uint64_t epoch) {
+std::uint64_t publishScan(const RingView& ring, const Scan& scan, std::uint64_t epoch, const DriverTally& tally,
+                          std::uint64_t writer_scan) {
   const std::uint64_t index = beginPublish(ring);
-  writePayload(ring, index, scan, epoch);
+  writePayload(ring, index, scan, epoch, tally, writer_scan);
   commitPublish(ring, index, scan);
   return index;
 }

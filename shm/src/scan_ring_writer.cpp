@@ -154,7 +154,7 @@ ScanRingWriter& ScanRingWriter::operator=(ScanRingWriter&& other) noexcept {
   return *this;
 }
 
-bool ScanRingWriter::publish(const Scan& scan) {
+bool ScanRingWriter::publish(const Scan& scan, const DriverTally& tally) {
   Impl& m = *impl_;
   if (!m.open) throw std::logic_error("ScanRingWriter::publish after close()");
   if (!scanFits(m.view, scan)) {
@@ -167,7 +167,7 @@ bool ScanRingWriter::publish(const Scan& scan) {
     m.view.header().oversize_drops.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
-  publishScan(m.view, scan, m.epoch);
+  publishScan(m.view, scan, m.epoch, tally, m.stats.published);
   ++m.stats.published;
   m.stats.points += scan.size();
   m.stats.bytes += payloadBytes(scan.size());

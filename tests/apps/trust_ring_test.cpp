@@ -1,6 +1,7 @@
 // Issue 18 (shared memory): `rigcal driver` never adopts a ring another user can touch, creates its own
 // private to its user, and bounds --slots by the bytes the ring takes; `rigcal map --shm` follows a driver
-// that is killed and restarted.
+// that is killed and restarted; a driver process's malformed packets reach the progress line of
+// `map --shm` and the summary and report.json of `calibrate --shm`.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -10,11 +11,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <regex>
+#include <string>
 #include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "rigcal/shm/ring_inspect.hpp"
 #include "rigcal/shm/scan_ring_reader.hpp"
@@ -25,6 +32,27 @@ namespace rigcal::test {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// A copy of `pcap` (Ethernet, classic pcap) in which `count` Velodyne data packets from a quarter of the
+/// way in have their first block header zeroed: the decoder drops each one as malformed.
+fs::path withMalformedPackets(const fs::path& pcap, const fs::path& out, int count) {
+  std::ifstream in(pcap, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  constexpr std::size_t kRecordHeader = 16, kEthIpUdp = 42, kDataPayload = 1206;
+  std::vector<std::size_t> payloads;
+  for (std::size_t at = 24; at + kRecordHeader <= bytes.size();) {
+    std::uint32_t captured = 0;
+    std::memcpy(&captured, bytes.data() + at + 8, 4);
+    if (captured == kEthIpUdp + kDataPayload) payloads.push_back(at + kRecordHeader + kEthIpUdp);
+    at += kRecordHeader + captured;
+  }
+  for (int i = 0; i < count; ++i) {
+    const std::size_t at = payloads.at(payloads.size() / 4 + std::size_t(i) * 3);
+    bytes[at] = bytes[at + 1] = 0;  // block 0's 0xFFEE
+  }
+  std::ofstream(out, std::ios::binary) << bytes;
+  return out;
+}
 
 class TrustRing : public ::testing::Test {
  protected:
@@ -211,6 +239,60 @@ TEST_F(TrustRing, MapFollowsARestartedDriver) {
   EXPECT_LT(m.exit_code, 128) << m.err;
   EXPECT_NE(m.err.find("warning: sensor 'roof': the writer of its ring is dead"), std::string::npos) << m.err;
   EXPECT_NE(m.err.find("warning: sensor 'roof': a new writer (epoch 2) after a gap of"), std::string::npos) << m.err;
+}
+
+// A driver process that drops malformed packets: `map --shm` shows them for its sensor as an in-process
+// driver's are shown (the count crosses the ring with each scan), and the driver's exit summary agrees.
+TEST_F(TrustRing, MapShowsTheMalformedPacketsOfADriverProcess) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  const fs::path damaged = withMalformedPackets(pcap, dir_ / "damaged.pcap", 5);
+  std::vector<std::string> args = driverArgs(damaged, "64");
+  args[8] = "1";  // --rate: the reader attaches (it polls every 100 ms) long before the last scan
+  RigcalProcess map({"map", "--config", rig_.string(), "--shm", "--shm-prefix", prefix_});
+  const CommandResult driver = RigcalProcess(args).wait();
+  const CommandResult m = map.wait();
+  ASSERT_EQ(driver.exit_code, 0) << driver.err;
+  EXPECT_NE(driver.out.find(" packets, 5 malformed, "), std::string::npos) << driver.out;
+  EXPECT_LT(m.exit_code, 128) << m.err;
+  EXPECT_TRUE(std::regex_search(m.out, std::regex(R"(scans [1-9]\d* \|.*\| roof (lost \d+ pkts, )?5 malformed)")))
+      << m.out << m.err;
+}
+
+// `calibrate --shm` with a calibration lidar whose driver process dropped malformed packets: the summary
+// warns with the count and report.json's input carries it per sensor, as for a damaged pcap.
+TEST_F(TrustRing, CalibrateReportsTheMalformedPacketsOfADriverProcess) {
+  RIGCAL_REQUIRE_DATA(pcap, "velodyne/hdl32e_example.pcap");
+  const fs::path damaged = withMalformedPackets(pcap, dir_ / "damaged.pcap", 4);
+  // Each driver reads its own capture on port 2368; calibrate only needs the sensors' names.
+  const fs::path left_rig = dir_ / "left.yaml", rig = dir_ / "calibrate.yaml", out = dir_ / "out";
+  std::ofstream(left_rig) << "sensors:\n  - name: left\n    model: HDL-32E\n    source: {port: 2368}\n"
+                             "roles:\n  mapping_lidar: left\n";
+  std::ofstream(rig) << "sensors:\n  - name: roof\n    model: HDL-32E\n    source: {port: 2368}\n"
+                        "  - name: left\n    model: HDL-32E\n    source: {port: 2369}\n"
+                        "roles:\n  mapping_lidar: roof\n  calibration_lidars: [left]\n";
+  RigcalProcess calibrate({"calibrate", "--config", rig.string(), "--shm", "--shm-prefix", prefix_, "--out",
+                           out.string()});
+  std::vector<std::string> roof = driverArgs(pcap, "64"), left = driverArgs(damaged, "64");
+  roof[8] = left[8] = "1";
+  left[2] = left_rig.string();
+  left[4] = "left";
+  RigcalProcess roof_driver(roof), left_driver(left);
+  EXPECT_EQ(roof_driver.wait().exit_code, 0);
+  EXPECT_EQ(left_driver.wait().exit_code, 0);
+  const CommandResult c = calibrate.wait();
+  fs::remove("/dev/shm/" + prefix_ + "left");
+  EXPECT_LT(c.exit_code, 128) << c.err;
+  // The zeroed packets also leave gaps in the sweep, which the driver counts as lost (as in process).
+  EXPECT_TRUE(std::regex_search(c.err, std::regex(R"(warning: left: \d+ of [1-9]\d* packets lost, 4 malformed, 0 too late)")))
+      << c.err;
+  EXPECT_EQ(c.err.find("warning: roof: "), std::string::npos) << "its input is clean\n" << c.err;
+  std::ifstream report(out / "report.json");
+  ASSERT_TRUE(report.good()) << c.out << c.err;
+  const auto j = nlohmann::json::parse(report);
+  EXPECT_EQ(j["input"]["left_packets_malformed"], "4") << j["input"].dump();
+  EXPECT_EQ(j["input"]["roof_packets_malformed"], "0") << j["input"].dump();
+  EXPECT_NE(j["input"]["left_packets_lost"], nullptr) << j["input"].dump();
+  EXPECT_NE(j["warnings"].dump().find("4 malformed"), std::string::npos) << j["warnings"].dump();
 }
 
 }  // namespace

@@ -183,6 +183,31 @@ TEST(McapReader, BadChunkCrcNamesFileAndChunkOffset) {
   EXPECT_NE(e.find("chunk CRC mismatch"), std::string::npos) << e;
 }
 
+// The next chunk is read and inflated on a second thread ahead of the reader: a bad chunk half-way through
+// an indexed file still comes out as its own error when the reader reaches it, after every message
+// before it, never earlier and never lost.
+TEST(McapReader, ABadChunkHalfWayFailsWhereTheReaderReachesIt) {
+  rigcal::test::TempDir dir;
+  McapTestWriter sequential;
+  for (std::uint64_t c = 0; c < 40; ++c) sequential.addChunk({msg(1, c * 10), msg(2, c * 10 + 5)}, c % 2 ? "zstd" : "lz4");
+  Bytes bytes = sequential.bytes(true);
+  const std::size_t bad = chunkOffsets(bytes).at(20);
+  bytes[bad + 9 + 24] ^= 0x01;  // its stored uncompressed CRC
+  McapTestWriter::save(dir / "bad_half_way.mcap", bytes);
+  Bag bag(dir / "bad_half_way.mcap");
+  std::vector<TimeNs> times;
+  try {
+    while (const auto m = bag.next()) times.push_back(m->log_time_ns);
+    ADD_FAILURE() << "the bad chunk was not reported";
+  } catch (const BagError& e) {
+    EXPECT_NE(std::string(e.what()).find("chunk at offset " + std::to_string(bad) + ": chunk CRC mismatch"),
+              std::string::npos)
+        << e.what();
+  }
+  ASSERT_EQ(times.size(), 40u) << "the 20 chunks before it, two messages each";
+  EXPECT_EQ(times.back(), TimeNs(19 * 10 + 5));
+}
+
 // Without a summary the file is walked record by record and the Data End's CRC of the data section is
 // checked: a flipped bit outside any chunk's own CRC (a chunk's start-time field) is caught there.
 TEST(McapReader, BadDataSectionCrcNamesFileAndDataEndOffset) {

@@ -108,6 +108,29 @@ TEST(RingProtocol, PublishThenReadRoundTripsEveryField) {
   EXPECT_EQ(readNext(view, next, out, &meta, counters), ReadOutcome::kEmpty);
 }
 
+// The writer's tally (issue 18: a driver process's malformed packets) crosses the ring with each scan and is
+// covered by the slot checksum: a flipped count is a checksum error, never a wrong number.
+TEST(RingProtocol, TheDriversTallyRoundTripsAndIsChecksummed) {
+  RingView view;
+  auto ring = makeRing(4, 100, view);
+  Scan in;
+  test::fillPattern(in, 7, test::patternPoints(7, 100));
+  const DriverTally tally{123456789012ULL, 5, 6, 7, 8};
+  publishScan(view, in, 1, tally, 9);
+  std::uint64_t next = 0;
+  Scan out;
+  ScanMeta meta;
+  ReadCounters counters;
+  ASSERT_EQ(readNext(view, next, out, &meta, counters), ReadOutcome::kScan);
+  EXPECT_EQ(meta.driver, tally);
+  EXPECT_EQ(meta.writer_scan, 9u);
+
+  publishScan(view, in, 1, tally);
+  view.slotHeader(1).tally_malformed.store(50);  // as a stray write would
+  EXPECT_EQ(readNext(view, next, out, &meta, counters), ReadOutcome::kEmpty);
+  EXPECT_EQ(counters.checksum_errors, 1u);
+}
+
 TEST(RingProtocol, LappedReaderSkipsToOldestAndCountsEveryLostScan) {
   RingView view;
   auto ring = makeRing(4, 100, view);

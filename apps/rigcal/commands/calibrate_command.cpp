@@ -232,8 +232,8 @@ void run(const CalibrateOptions& o) {
     }
   }
   if (inputs.empty()) {
-    // Scans from shared-memory rings: their drivers run elsewhere, but each scan says how many packets it
-    // lost, so the damage is still reported per sensor.
+    // Scans handed in without a driver (rings have their drivers' tallies in inputs()): each scan says how
+    // many packets it lost, so that damage is still reported per sensor.
     std::vector<std::pair<std::string, std::uint64_t>> lost{{progress_now.mapping_sensor, progress_now.mapping_lost_packets}};
     for (const auto& l : progress_now.lidars) lost.emplace_back(l.sensor, l.lost_packets);
     for (const auto& [sensor, n] : lost) {

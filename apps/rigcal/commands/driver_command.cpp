@@ -1,7 +1,9 @@
 // `rigcal driver --config RIG --sensor NAME (--live | --pcap F [--rate R] | --bag B [--topic T] [--rate R])`: one sensor's driver in its
 // own process, writing every finished scan into the shared-memory ring /rigcal.<sensor>.
+#include <algorithm>
 #include <iomanip>
 #include <filesystem>
+#include <limits>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -14,6 +16,7 @@
 #include "rigcal/core/cpu_latency_request.hpp"
 #include "rigcal/pipeline/sensor_driver.hpp"
 #include "rigcal/shm/ring_error.hpp"
+#include "rigcal/shm/driver_tally.hpp"
 #include "rigcal/shm/ring_layout.hpp"
 #include "rigcal/shm/scan_ring_writer.hpp"
 
@@ -57,6 +60,22 @@ void checkRingSize(unsigned slots, std::uint32_t max_points) {
                                       " slots for this sensor");
 }
 
+std::uint32_t saturated(std::uint64_t n) {
+  return std::uint32_t(std::min<std::uint64_t>(n, std::numeric_limits<std::uint32_t>::max()));
+}
+
+// What the driver has counted so far, for the ring's readers (read on the driver's thread, which owns it).
+shm::DriverTally tallyOf(const pipeline::SensorDriver& driver) {
+  const auto& a = driver.assemblerStats();
+  shm::DriverTally t;
+  t.packets = a.packets;
+  t.malformed = saturated(a.malformed + driver.sourceStats().malformed);
+  t.late_dropped = saturated(a.late_dropped);
+  t.reordered = saturated(a.reordered);
+  t.foreign = saturated(driver.foreignPackets().packets);
+  return t;
+}
+
 void run(const DriverOptions& o) {
   config::RigConfig rig;
   config::SensorConfig sensor;
@@ -89,7 +108,7 @@ void run(const DriverOptions& o) {
   std::unique_ptr<pipeline::SensorDriver> driver;
   try {
     driver = std::make_unique<pipeline::SensorDriver>(sensor, input, StopSignals::flag(), [&](Scan&& scan) {
-      ring->publish(scan) ? ++published : ++dropped;
+      ring->publish(scan, tallyOf(*driver)) ? ++published : ++dropped;
     });
     shm::WriterOptions w;
     w.sensor = sensor.name;
@@ -115,7 +134,8 @@ void run(const DriverOptions& o) {
 
   const auto& a = driver->assemblerStats();
   std::cout << "driver '" << sensor.name << "': " << published << " scans published, " << dropped
-            << " too large for a slot; " << a.packets << " packets, " << a.malformed << " malformed, "
+            << " too large for a slot; " << a.packets << " packets, " << a.malformed + driver->sourceStats().malformed
+            << " malformed, "
             << a.lost_packets << " lost" << std::endl;
   if (!driver->warning().empty()) std::cerr << "warning: " << driver->warning() << '\n';
   if (driver->foreignPackets().packets > 0)

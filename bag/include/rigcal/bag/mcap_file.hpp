@@ -2,7 +2,9 @@
 // A streaming MCAP reader. With a summary (chunk indexes) it reads only the chunks it needs, in
 // message-time order; without one (or when the file was cut short) it first walks the records once to
 // find chunks and channels, checking CRCs, and keeps what came before a cut with a warning. Memory holds
-// only the chunks whose time ranges overlap the message being delivered.
+// only the chunks whose time ranges overlap the message being delivered, and the next chunk, which a
+// second thread reads and inflates (CRC checked) while the caller decodes the current one; its errors
+// surface when the reader reaches that chunk, as they would without it.
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -19,6 +21,8 @@
 #include "rigcal/bag/storage_reader.hpp"
 
 namespace rigcal::bag {
+
+class PrefetchThread;
 
 class McapFile final : public StorageReader {
  public:
@@ -54,6 +58,7 @@ class McapFile final : public StorageReader {
     std::size_t next = 0;
     std::span<const std::uint8_t> records;
     std::size_t order = 0;  // ties between chunks go to the earlier one
+    std::uint8_t opcode = 0;  // of the record: a chunk, or a lone message
   };
   struct HeapItem {
     std::uint64_t log_time;
@@ -71,7 +76,12 @@ class McapFile final : public StorageReader {
   void addChannel(const mcap::ChannelRecord& c, const std::string& what);
   /// Walks a chunk's records: registers schemas/channels and lists its messages.
   void indexRecords(std::span<const std::uint8_t> records, const std::string& what, std::vector<Entry>* entries);
+  std::unique_ptr<Loaded> spareChunk();
+  /// Reads the record of `ref` into `chunk` and inflates a chunk (CRC checked). Touches only `chunk`, the
+  /// file and `decompressor`: it runs on the prefetch thread too.
+  void fetch(const Ref& ref, Loaded& chunk, mcap::ChunkDecompressor& decompressor) const;
   void load(const Ref& ref, std::size_t order);
+  void prefetch(std::size_t order);
 
   std::filesystem::path path_;
   ReadOnlyFile file_;
@@ -87,6 +97,11 @@ class McapFile final : public StorageReader {
   std::priority_queue<HeapItem, std::vector<HeapItem>, std::greater<>> heap_;
   Loaded* retired_ = nullptr;
   std::size_t peak_loaded_ = 0;  // exhausted chunk whose bytes the last message still points into
+  // The next chunk, fetched on prefetch_ while the caller decodes the current ones.
+  std::unique_ptr<Loaded> ahead_;
+  std::size_t ahead_order_ = 0;
+  mcap::ChunkDecompressor ahead_decompressor_;  // the prefetch thread's own zstd / lz4 contexts
+  std::unique_ptr<PrefetchThread> prefetch_;    // last: joined before anything its job uses is destroyed
 };
 
 }  // namespace rigcal::bag

@@ -71,8 +71,8 @@ struct LidarProgress {
   int budget = 0;                // lidar_calibration_max_frames
   bool handed_over = false;      // its dataset went to the callback
   std::uint64_t lost_packets = 0;  // the packets its scans say were lost (any input: pcap, live, rings)
-  /// Packets its driver dropped as malformed so far (pcap, bag, live; a shared-memory ring does not carry
-  /// them: its driver process reports them on exit).
+  /// Packets its driver dropped as malformed so far (pcap, bag, live; for a shared-memory ring, as its
+  /// driver process had counted them when it published the newest scan read).
   std::uint64_t malformed_packets = 0;
 };
 
@@ -141,7 +141,7 @@ struct Shortfall {
   std::string message;  // "1 of 2 frames for left: drive further or lower lidar_calibration_min_frames"
 };
 
-/// One sensor's input as its driver saw it (pcap or live input; complete after finish()): what a damaged
+/// One sensor's input as its driver saw it (pcap, live or ring input; complete after finish()): what a damaged
 /// capture or a lossy network cost, and the sensor's clock against the capture / receive time.
 struct SensorInput {
   std::string sensor;
@@ -193,7 +193,10 @@ class Pipeline {
   /// A snapshot; complete after finish(). `with_dense_cloud` also merges the dense cloud (seconds).
   [[nodiscard]] MappingResult mapping(bool with_dense_cloud = false) const;
   [[nodiscard]] std::vector<Shortfall> shortfalls() const;  // after finish()
-  [[nodiscard]] std::vector<SensorInput> inputs() const;    // after finish(); empty for kInProcess / kShm
+  /// After finish(); empty for kInProcess. For kShm, one per ring as its driver process counted (the tally
+  /// in the newest scan read, from the first scan read if the driver was already running, summed over
+  /// restarted writers; no clock lag, last error or capture warning).
+  [[nodiscard]] std::vector<SensorInput> inputs() const;
 
  private:
   struct Impl;

@@ -11,7 +11,8 @@
 namespace rigcal::shm {
 
 inline constexpr std::uint64_t kRingMagic = 0x31474e4952534752ULL;  // "RGSRING1" read as little-endian
-inline constexpr std::uint32_t kLayoutVersion = 1;
+// 2: SlotHeader carries the driver's running tally (DriverTally) and takes two cache lines.
+inline constexpr std::uint32_t kLayoutVersion = 2;
 inline constexpr std::size_t kCacheLine = 64;
 inline constexpr std::uint32_t kMaxReaders = 16;   // reader records the monitor can see
 inline constexpr std::size_t kSensorNameBytes = 64;
@@ -81,6 +82,13 @@ struct alignas(kCacheLine) SlotHeader {
   std::atomic<std::uint64_t> epoch;      // of the writer that wrote the slot
   std::atomic<std::uint32_t> point_count;
   std::atomic<std::uint32_t> missing_packets;
+  // The writer's DriverTally when it published the scan (running totals, not per scan).
+  std::atomic<std::uint64_t> tally_packets;
+  std::atomic<std::uint32_t> tally_malformed;
+  std::atomic<std::uint32_t> tally_late_dropped;
+  std::atomic<std::uint32_t> tally_reordered;
+  std::atomic<std::uint32_t> tally_foreign;
+  std::atomic<std::uint64_t> writer_scan;  // scans this writer published before this one (0: its first)
 };
 
 /// Where each point array sits inside a slot, for a given capacity. Arrays start on cache lines.
@@ -151,6 +159,9 @@ constexpr std::uint64_t computeLayoutHash() {
       offsetof(SlotHeader, stamp_ns), offsetof(SlotHeader, publish_ns),
       offsetof(SlotHeader, checksum), offsetof(SlotHeader, epoch),
       offsetof(SlotHeader, point_count), offsetof(SlotHeader, missing_packets),
+      offsetof(SlotHeader, tally_packets), offsetof(SlotHeader, tally_malformed),
+      offsetof(SlotHeader, tally_late_dropped), offsetof(SlotHeader, tally_reordered),
+      offsetof(SlotHeader, tally_foreign), offsetof(SlotHeader, writer_scan),
       slotGeometry(1000).offset_ns, slotGeometry(1000).return_index, slotGeometry(1000).slot_bytes,
   };
   std::uint64_t h = 0xcbf29ce484222325ULL;
@@ -168,7 +179,7 @@ static_assert(std::atomic<std::uint32_t>::is_always_lock_free);
 static_assert(std::atomic<std::int32_t>::is_always_lock_free);
 static_assert(sizeof(std::atomic<std::uint32_t>) == 4, "the futex word must be a plain 32-bit word");
 static_assert(std::is_standard_layout_v<RingHeader> && std::is_standard_layout_v<SlotHeader>);
-static_assert(sizeof(SlotHeader) == kCacheLine);
+static_assert(sizeof(SlotHeader) == 2 * kCacheLine);
 static_assert(sizeof(RingHeader) % kCacheLine == 0);
 static_assert(offsetof(RingHeader, magic) == 0);
 

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "rigcal/core/scan.hpp"
+#include "rigcal/shm/driver_tally.hpp"
 #include "rigcal/shm/ring_layout.hpp"
 
 namespace rigcal::shm {
@@ -24,6 +25,9 @@ struct ScanMeta {
   std::uint64_t ring_index = 0;  // position in the ring's publication order (continues across writers)
   std::uint64_t epoch = 0;       // epoch of the writer that published it
   std::int64_t publish_ns = 0;   // CLOCK_MONOTONIC when it was complete in its slot, just before it became visible
+  DriverTally driver;            // its writer's running tally when it published the scan
+  std::uint64_t writer_scan = 0;  // scans its writer published before it: 0 = the writer's first, so the
+                                  // tally covers everything that writer counted
 };
 
 /// A mapped ring: header and slots, wherever this process mapped them.
@@ -65,12 +69,15 @@ HeaderState checkHeader(const void* base, std::size_t bytes, const std::string& 
 /// True if `scan`'s arrays all have the same length, which is at most the slot capacity.
 [[nodiscard]] bool scanFits(const RingView& ring, const Scan& scan);
 
-/// Publishes `scan` (which must fit) as ring index write_index and wakes sleeping readers; returns it.
-std::uint64_t publishScan(const RingView& ring, const Scan& scan, std::uint64_t epoch);
+/// Publishes `scan` (which must fit) with its writer's `tally` as ring index write_index and wakes
+/// sleeping readers; returns the index.
+std::uint64_t publishScan(const RingView& ring, const Scan& scan, std::uint64_t epoch, const DriverTally& tally = {},
+                          std::uint64_t writer_scan = 0);
 
 /// The steps of publishScan, exposed so a test can stop between them (a writer dying mid-write).
 std::uint64_t beginPublish(const RingView& ring);  // seq odd; returns the index being written
-void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch);
+void writePayload(const RingView& ring, std::uint64_t index, const Scan& scan, std::uint64_t epoch,
+                  const DriverTally& tally = {}, std::uint64_t writer_scan = 0);
 void commitPublish(const RingView& ring, std::uint64_t index, const Scan& scan);  // seq even, index+1, wake
 
 /// Bumps the futex word and wakes every sleeping reader (after a publish, on close, after a takeover).

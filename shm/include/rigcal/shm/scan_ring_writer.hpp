@@ -31,9 +31,10 @@ class ScanRingWriter {
   ScanRingWriter(ScanRingWriter&&) noexcept;
   ScanRingWriter& operator=(ScanRingWriter&&) noexcept;
 
-  /// Publishes a copy of `scan` and wakes waiting readers. False (scan dropped, counted) if it has more
-  /// points than a slot holds. Throws std::invalid_argument if its arrays differ in length.
-  bool publish(const Scan& scan);
+  /// Publishes a copy of `scan`, with what its driver has counted so far, and wakes waiting readers. False
+  /// (scan dropped, counted) if it has more points than a slot holds. Throws std::invalid_argument if its
+  /// arrays differ in length.
+  bool publish(const Scan& scan, const DriverTally& tally = {});
   /// Tells readers this writer is alive while it has nothing to publish (publish() does it too).
   void heartbeat();
   /// Marks the ring closed, wakes readers, unlinks the segment. Idempotent; the destructor calls it.
