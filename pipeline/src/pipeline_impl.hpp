@@ -38,6 +38,16 @@ constexpr std::chrono::microseconds kPollTimeout{100'000};  // stage threads re-
 constexpr std::size_t kLosslessCapacity = 1 << 16;          // small messages that must never be dropped
 constexpr TimeNs kCalibrationLeadNs = kNsPerSec;            // offline pcap: calibration lidars run ahead by ≤ 1 s
 constexpr std::int64_t kRealtimeHoldNs = 1'000'000'000;     // real time: longest wait for the trajectory
+/// Offline the sources outrun the mapper, so the scan queues sit full: at 32 scans of a 128-beam lidar
+/// (~5 MB each) the input queues alone held ~340 MB, and the deskew stage's held calibration scans grow
+/// with the mapper's backlog (issue #18). A few scans keep every stage busy. Real time keeps the option's
+/// capacity: there the queue is what absorbs a slow stage before scans are dropped.
+constexpr std::size_t kOfflineScanQueueCapacity = 4;
+
+inline std::size_t scanQueueCapacity(const PipelineOptions& o) {
+  const std::size_t wanted = std::max<std::size_t>(2, o.queue_capacity);
+  return o.mode == PipelineMode::kOffline ? std::min(wanted, kOfflineScanQueueCapacity) : wanted;
+}
 
 struct ScanItem {
   std::shared_ptr<Scan> scan;
@@ -169,11 +179,11 @@ struct Pipeline::Impl {
         options(o),
         on_dataset(std::move(cb)),
         realtime(o.mode == PipelineMode::kRealtime),
-        q_in(std::max<std::size_t>(2, o.queue_capacity)),
-        q_map(std::max<std::size_t>(2, o.queue_capacity)),
+        q_in(scanQueueCapacity(o)),
+        q_map(scanQueueCapacity(o)),
         q_pose(kLosslessCapacity),
         q_frames(kLosslessCapacity),
-        q_cal(std::max<std::size_t>(2, o.queue_capacity)),
+        q_cal(scanQueueCapacity(o)),
         q_cand(kLosslessCapacity),
         mapper(r.parameters, o.mode == PipelineMode::kOffline) {
     mapper.deferPostPoseWork(true);  // the mapper stage publishes the pose before the frame's other work

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "cell_knn.hpp"
+#include "compact_covariances.hpp"
 #include "offset_sums.hpp"
 #include "rigcal/registration/parallel.hpp"
 
@@ -49,11 +50,33 @@ Eigen::Vector3d smallestEigenvector(const Eigen::Matrix3d& c) {
   return eig.eigenvectors().col(0);
 }
 
+// Where the shapes go: the cloud's 4x4 covariances, or (a Target's build, which keeps nothing else) each
+// covariance's upper triangle in float, 6 a point, without the 128-byte matrices ever existing.
+struct ShapeSink {
+  PointCloud* cloud = nullptr;
+  float* upper = nullptr;  // non-null: the compact form instead of cloud->covariances
+
+  void covariance(std::size_t i, const Eigen::Matrix3d& c) const {
+    if (upper == nullptr) {
+      cloud->covariances[i].topLeftCorner<3, 3>() = c;
+      return;
+    }
+    float* u = upper + 6 * i;
+    u[0] = static_cast<float>(c(0, 0));
+    u[1] = static_cast<float>(c(0, 1));
+    u[2] = static_cast<float>(c(0, 2));
+    u[3] = static_cast<float>(c(1, 1));
+    u[4] = static_cast<float>(c(1, 2));
+    u[5] = static_cast<float>(c(2, 2));
+  }
+};
+
 // Normal and plane-regularised covariance of point i from its `found` nearest (the point itself among
 // them); false (isotropic, no normal) with fewer than 3.
-bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t found, double plane_epsilon) {
+bool fillShape(const ShapeSink& sink, std::size_t i, const Neighbor* nb, std::size_t found, double plane_epsilon) {
+  PointCloud& cloud = *sink.cloud;
   if (found < 3) {
-    cloud.covariances[i].topLeftCorner<3, 3>().setIdentity();
+    sink.covariance(i, Eigen::Matrix3d::Identity());
     return false;
   }
   // One pass of sums relative to the point itself (offsets of a neighbourhood: exact enough in double
@@ -74,8 +97,7 @@ bool fillShape(PointCloud& cloud, std::size_t i, const Neighbor* nb, std::size_t
   cov(2, 2) = szz * inv - mz * mz;
   // U·diag(ε, 1, 1)·Uᵀ = I − (1 − ε)·n·nᵀ for orthonormal U: only the normal is needed.
   Eigen::Vector3d normal = smallestEigenvector(cov);
-  cloud.covariances[i].topLeftCorner<3, 3>() =
-      Eigen::Matrix3d::Identity() - (1.0 - plane_epsilon) * (normal * normal.transpose());
+  sink.covariance(i, Eigen::Matrix3d::Identity() - (1.0 - plane_epsilon) * (normal * normal.transpose()));
   if (normal.dot(cloud.points[i].head<3>()) > 0.0) normal = -normal;  // face the sensor at the origin
   cloud.normals[i].head<3>() = normal;
   return true;
@@ -120,7 +142,8 @@ detail::CellKnn allNearest(const PointCloud& cloud, std::size_t k, int num_threa
 // `degree` other points; the next other point bounds the distance of everything not listed: that is the
 // radius the list vouches for.
 CovarianceStats shapesAndGraph(PointCloud& cloud, const detail::CellKnn& knn, std::size_t k,
-                               const CovarianceOptions& options, NeighborGraph* graph, std::size_t degree) {
+                               const CovarianceOptions& options, NeighborGraph* graph, std::size_t degree,
+                               std::vector<float>* upper = nullptr) {
   const std::size_t n = cloud.size();
   const std::size_t k_query = knn.k;
   if (graph != nullptr) {
@@ -129,7 +152,14 @@ CovarianceStats shapesAndGraph(PointCloud& cloud, const detail::CellKnn& knn, st
     graph->radius.assign(n, 0.0F);
   }
   cloud.normals.assign(n, Eigen::Vector4d::Zero());
-  cloud.covariances.assign(n, Eigen::Matrix4d::Zero());
+  ShapeSink sink{&cloud, nullptr};
+  if (upper != nullptr) {
+    std::vector<Eigen::Matrix4d>().swap(cloud.covariances);
+    upper->assign(6 * n, 0.0F);
+    sink.upper = upper->data();
+  } else {
+    cloud.covariances.assign(n, Eigen::Matrix4d::Zero());
+  }
   std::atomic<std::size_t> isolated{0};
   parallelFor(chunkCount(n, kDefaultChunk), options.num_threads, [&](std::size_t task) {
     if (options.deadline.expired()) return;
@@ -150,23 +180,35 @@ CovarianceStats shapesAndGraph(PointCloud& cloud, const detail::CellKnn& knn, st
         }
         if (m == degree && next < all) graph->radius[i] = std::sqrt(nb[next].sq_distance);
       }
-      if (!fillShape(cloud, i, nb, std::min(all, k), options.plane_epsilon)) ++local_isolated;
+      if (!fillShape(sink, i, nb, std::min(all, k), options.plane_epsilon)) ++local_isolated;
     }
     isolated.fetch_add(local_isolated, std::memory_order_relaxed);
   });
   return {n, isolated.load()};
 }
 
-}  // namespace
-
-CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const CovarianceOptions& options,
-                                    NeighborGraph* graph, std::size_t graph_degree) {
+// The k-NN pass over `tree` and the shapes (and graph) from it, into cloud.covariances or `upper`.
+CovarianceStats shapesWithTree(PointCloud& cloud, const KdTree& tree, const CovarianceOptions& options,
+                               NeighborGraph* graph, std::size_t graph_degree, std::vector<float>* upper) {
   const std::size_t k = static_cast<std::size_t>(std::max(options.num_neighbors, 3));
   const std::size_t degree = graph != nullptr ? graph_degree : 0;
   const std::size_t k_query = std::max(k, degree + 2);  // the graph wants itself, `degree` others and the next
   const detail::CellKnn knn = allNearest(cloud, k_query, options.num_threads, &tree, options.deadline);
   if (options.deadline.expired()) return {cloud.size(), 0};  // incomplete neighbours: never read them
-  return shapesAndGraph(cloud, knn, k, options, graph, degree);
+  return shapesAndGraph(cloud, knn, k, options, graph, degree, upper);
+}
+
+}  // namespace
+
+CovarianceStats estimateCovariances(PointCloud& cloud, const KdTree& tree, const CovarianceOptions& options,
+                                    NeighborGraph* graph, std::size_t graph_degree) {
+  return shapesWithTree(cloud, tree, options, graph, graph_degree, nullptr);
+}
+
+CovarianceStats detail::estimateCompactCovariances(PointCloud& cloud, const KdTree& tree,
+                                                   const CovarianceOptions& options, NeighborGraph* graph,
+                                                   std::size_t graph_degree, std::vector<float>* upper) {
+  return shapesWithTree(cloud, tree, options, graph, graph_degree, upper);
 }
 
 CovarianceStats estimateCovariances(PointCloud& cloud, const CovarianceOptions& options) {

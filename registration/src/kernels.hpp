@@ -85,7 +85,7 @@ struct Sym3 {
   static Sym3 upperOf(const Eigen::Matrix4d& C) {
     return {C(0, 0), C(0, 1), C(0, 2), C(1, 1), C(1, 2), C(2, 2)};
   }
-  /// From 6 consecutive doubles (Target::covarianceUpper()).
+  /// From 6 consecutive doubles or floats (Target::covarianceUpperFloat()).
   static Sym3 load(const double* u) { return {u[0], u[1], u[2], u[3], u[4], u[5]}; }
   static Sym3 load(const float* u) { return {u[0], u[1], u[2], u[3], u[4], u[5]}; }
   [[nodiscard]] Eigen::Vector3d times(const Eigen::Vector3d& v) const {

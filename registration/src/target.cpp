@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "compact_covariances.hpp"
+
 namespace rigcal::registration {
 
 Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::move(cloud)) {
@@ -46,7 +48,8 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
     cov.num_threads = options.num_threads;
     cov.deadline = options.deadline;
     if (options.normals_and_covariances && !(cloud_.hasNormals() && cloud_.hasCovariances())) {
-      estimateCovariances(cloud_, tree_, cov, &graph_, options.neighbor_graph_degree);
+      detail::estimateCompactCovariances(cloud_, tree_, cov, &graph_, options.neighbor_graph_degree,
+                                         &covariance_upper_float_);
     } else {
       // Only the graph is missing: run the same k-NN pass on a scratch copy and keep the cloud's own
       // normals and covariances.
@@ -61,11 +64,15 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
     return;
   }
   if (cloud_.hasCovariances()) {
-    covariance_upper_.reserve(6 * cloud_.size());
+    // Covariances the cloud came with. Only the compact float form is read (GICP): the 4x4 matrices
+    // (128 bytes a point) are dropped, which on a calibration's ~10 targets is most of its memory.
+    covariance_upper_float_.reserve(6 * cloud_.size());
     for (const Eigen::Matrix4d& c : cloud_.covariances) {
-      covariance_upper_.insert(covariance_upper_.end(), {c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2)});
+      for (const double v : {c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2)}) {
+        covariance_upper_float_.push_back(static_cast<float>(v));
+      }
     }
-    covariance_upper_float_.assign(covariance_upper_.begin(), covariance_upper_.end());
+    std::vector<Eigen::Matrix4d>().swap(cloud_.covariances);
   }
   for (const double resolution : options.ndt_resolutions) {
     if (ndtGrid(resolution) != nullptr) continue;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <algorithm>
 #include <vector>
@@ -221,19 +222,25 @@ TEST(Target, BuildsRequestedStructuresAndDropsNonFinitePoints) {
   Neighbor nn;
   ASSERT_TRUE(t.tree().nearest(t.cloud().points[42], 1e-6, &nn));
   EXPECT_EQ(nn.index, 42u);
-  // The compact copy GICP reads is each stored covariance's upper triangle, in the same order.
-  ASSERT_EQ(t.covarianceUpper().size(), 6 * t.size());
-  for (const std::size_t i : {std::size_t{0}, std::size_t{42}, t.size() - 1}) {
-    const Eigen::Matrix4d& C = t.cloud().covariances[i];
-    const double* u = t.covarianceUpper().data() + 6 * i;
-    EXPECT_EQ(u[0], C(0, 0));
-    EXPECT_EQ(u[1], C(0, 1));
-    EXPECT_EQ(u[2], C(0, 2));
-    EXPECT_EQ(u[3], C(1, 1));
-    EXPECT_EQ(u[4], C(1, 2));
-    EXPECT_EQ(u[5], C(2, 2));
+  // Only the compact float form is kept (issue #18: the 4x4 matrices were most of a target's memory): each
+  // point's covariance upper triangle, in the stored order, as estimating them on the stored points gives.
+  EXPECT_TRUE(t.cloud().covariances.empty());
+  PointCloud again;
+  again.points = t.cloud().points;
+  NeighborGraph graph;
+  estimateCovariances(again, t.tree(), CovarianceOptions{}, &graph, options.neighbor_graph_degree);
+  ASSERT_EQ(t.covarianceUpperFloat().size(), 6 * t.size());
+  // The Target writes them without the 4x4 matrices: every one bit-identical to the matrices' float.
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const Eigen::Matrix4d& C = again.covariances[i];
+    const float* u = t.covarianceUpperFloat().data() + 6 * i;
+    const float expected[6] = {static_cast<float>(C(0, 0)), static_cast<float>(C(0, 1)), static_cast<float>(C(0, 2)),
+                               static_cast<float>(C(1, 1)), static_cast<float>(C(1, 2)), static_cast<float>(C(2, 2))};
+    ASSERT_EQ(std::memcmp(u, expected, sizeof expected), 0) << "point " << i;
+    ASSERT_EQ(t.cloud().normals[i], again.normals[i]) << "point " << i;
   }
-  EXPECT_TRUE(Target(test::room(0.2)).covarianceUpper().empty());
+  EXPECT_EQ(t.neighborGraph().neighbors, graph.neighbors);
+  EXPECT_TRUE(Target(test::room(0.2)).covarianceUpperFloat().empty());
 }
 
 }  // namespace

@@ -38,9 +38,9 @@ TEST(TargetDeadline, ADeadlineThatDoesNotExpireBuildsTheSameTarget) {
   ASSERT_FALSE(b.stopped());
   ASSERT_EQ(a.size(), b.size());
   ASSERT_TRUE(b.hasCovariances());
-  ASSERT_EQ(a.covarianceUpper().size(), b.covarianceUpper().size());
-  EXPECT_EQ(std::memcmp(a.covarianceUpper().data(), b.covarianceUpper().data(),
-                        a.covarianceUpper().size_bytes()),
+  ASSERT_EQ(a.covarianceUpperFloat().size(), b.covarianceUpperFloat().size());
+  EXPECT_EQ(std::memcmp(a.covarianceUpperFloat().data(), b.covarianceUpperFloat().data(),
+                        a.covarianceUpperFloat().size_bytes()),
             0)
       << "bit-identical covariances";
   ASSERT_NE(b.ndtGrid(1.0), nullptr);

@@ -38,12 +38,13 @@ class Target {
   /// cloud() indices differ from the input's.
   explicit Target(PointCloud cloud, const TargetOptions& options = {});
 
+  /// Positions and normals; never covariances (see covarianceUpperFloat()).
   [[nodiscard]] const PointCloud& cloud() const { return cloud_; }
   [[nodiscard]] const KdTree& tree() const { return tree_; }
   [[nodiscard]] std::size_t size() const { return cloud_.size(); }
   [[nodiscard]] bool empty() const { return cloud_.empty(); }
   [[nodiscard]] bool hasNormals() const { return cloud_.hasNormals(); }
-  [[nodiscard]] bool hasCovariances() const { return cloud_.hasCovariances(); }
+  [[nodiscard]] bool hasCovariances() const { return !covariance_upper_float_.empty(); }
   /// Empty unless built (see TargetOptions::neighbor_graph).
   [[nodiscard]] const NeighborGraph& neighborGraph() const { return graph_; }
   /// The grid built for this resolution (within 1e-9 m), or nullptr.
@@ -51,13 +52,10 @@ class Target {
   [[nodiscard]] std::size_t droppedNonFinite() const { return dropped_; }
   /// TargetOptions::deadline expired during the build: the target is incomplete and must not be used.
   [[nodiscard]] bool stopped() const { return stopped_; }
-  /// Each covariance's upper triangle (xx, xy, xz, yy, yz, zz), 6 doubles per point in cloud() order, or
-  /// empty without covariances. GICP reads these: 48 bytes instead of a Matrix4d's 128 per match, which
-  /// on a dense map decides how much of it stays in cache.
-  [[nodiscard]] std::span<const double> covarianceUpper() const { return covariance_upper_; }
-  /// The same in float (24 bytes per point): what GICP's linearisation reads, so more of a dense map's
-  /// covariances stay in cache. Their entries are O(1) (plane-regularised), so float loses nothing a
-  /// GICP weight needs.
+  /// Each covariance's upper triangle (xx, xy, xz, yy, yz, zz) in float, 6 per point in cloud() order, or
+  /// empty without covariances: the only form kept (24 bytes a point instead of a Matrix4d's 128), which
+  /// keeps a calibration's targets small and more of a dense map's covariances in GICP's cache. Their
+  /// entries are O(1) (plane-regularised), so float loses nothing a GICP weight needs.
   [[nodiscard]] std::span<const float> covarianceUpperFloat() const { return covariance_upper_float_; }
 
  private:
@@ -67,7 +65,6 @@ class Target {
   std::vector<NdtGrid> grids_;
   std::size_t dropped_ = 0;
   bool stopped_ = false;
-  std::vector<double> covariance_upper_;
   std::vector<float> covariance_upper_float_;
 };
 
