@@ -69,9 +69,14 @@ void Calibrator::run() {
   // Whatever time is left: upstream's exhaustive ensemble (every registrator from every candidate),
   // which guards against a wrong basin; a better result gets the final batched refinement too.
   t = Clock::now();
+  // Here the plan is done: every frame through its ensemble, the batched chain, the re-deskew. The
+  // exhaustive pass only searches other basins in the time left, so the deadline ending it does not make the
+  // result "the best so far of a cut plan" (deadline_reached): with it, no default run could ever finish.
+  const bool plan_finished = !stopped();
   const Pose before_exhaustive = best_;
   for (std::size_t k = 0; k < frames_.size() && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
   if (!samePose(before_exhaustive, best_) && !stopped()) batchedChain(best_);
+  if (plan_finished && (deadline_.token() == nullptr || !deadline_.token()->cancelled())) out_.deadline_reached = false;
   ensemble_seconds += since(t);
   out_.stage_seconds = {{"targets", target_seconds},
                         {"ensemble", ensemble_seconds},
