@@ -54,6 +54,11 @@ void Calibrator::run() {
     t = Clock::now();
   }
   target_seconds += since(t);
+  // A next target that did not fit ends the targets, not the plan: the frames built so far still get the
+  // rescore, the batched chain and their ensembles in the time left (it had skipped all of them: under load
+  // the batched ICP never ran). The plan is marked cut at the end.
+  const bool targets_cut = out_.deadline_reached || next < data_.frames.size();
+  if (out_.deadline_reached && !deadline_.expired()) out_.deadline_reached = false;
   // Rescoring the guess and the best over the grown set costs two scores of the new size.
   const double grown = double(frames_.size()) / double(first_frames);
   if (frames_.size() > first_frames && fits(deadline_, 2.5 * grown * score_seconds_)) rescore();
@@ -78,11 +83,12 @@ void Calibrator::run() {
   // Here the plan is done: every frame through its ensemble, the batched chain, the re-deskew. The
   // exhaustive pass only searches other basins in the time left, so the deadline ending it does not make the
   // result "the best so far of a cut plan" (deadline_reached): with it, no default run could ever finish.
-  const bool plan_finished = !stopped();
+  const bool plan_finished = !stopped() && !targets_cut;
   const Pose before_exhaustive = best_;
   for (std::size_t k = 0; k < frames_.size() && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
   if (!samePose(before_exhaustive, best_) && !stopped()) batchedChain(best_);
   if (plan_finished && (deadline_.token() == nullptr || !deadline_.token()->cancelled())) out_.deadline_reached = false;
+  if (targets_cut) out_.deadline_reached = true;
   ensemble_seconds += since(t);
   out_.stage_seconds = {{"targets", target_seconds},
                         {"ensemble", ensemble_seconds},
