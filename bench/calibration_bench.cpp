@@ -1,8 +1,9 @@
 // The lidar-lidar ensemble on simulator data (parking-lot, a 10 s stretch, 4 frames, guess 0.3 m / 5° off):
 // time per registrator on one frame (our NDT / GICP / ICP coarse, fine, ultra-fine against PCL 1.13's NDT,
-// GICP and ICP with upstream's settings, the baseline upstream runs), the augmented-target build, the
-// all-frames score, batched ICP, and a whole calibrateLidarLidar run under the default 10 s deadline (without
-// one, the exhaustive pass runs every registrator from every candidate: ~870 registrations).
+// GICP and ICP with upstream's settings, the baseline upstream runs), the augmented-target build (the first
+// frame's box crop, a later frame's near crop, and the crop alone), the all-frames score, batched ICP, and
+// a whole calibrateLidarLidar run under the default 10 s deadline (without one, the exhaustive pass runs
+// every registrator from every candidate: ~870 registrations).
 // Run pinned: taskset -c 0,1 calibration_bench --benchmark_repetitions=10 (median and p99 are reported).
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
