@@ -1,8 +1,9 @@
 // The lidar-lidar ensemble on simulator data (parking-lot, a 10 s stretch, 4 frames, guess 0.3 m / 5° off):
 // time per registrator on one frame (our NDT / GICP / ICP coarse, fine, ultra-fine against PCL 1.13's NDT,
-// GICP and ICP with upstream's settings, the baseline upstream runs), the augmented-target build, the
-// all-frames score, batched ICP, and a whole calibrateLidarLidar run under the default 10 s deadline (without
-// one, the exhaustive pass runs every registrator from every candidate: ~870 registrations).
+// GICP and ICP with upstream's settings, the baseline upstream runs), the augmented-target build (the first
+// frame's box crop, a later frame's near crop, and the crop alone), the all-frames score, batched ICP, and
+// a whole calibrateLidarLidar run under the default 10 s deadline (without one, the exhaustive pass runs
+// every registrator from every candidate: ~870 registrations).
 // Run pinned: taskset -c 0,1 calibration_bench --benchmark_repetitions=10 (median and p99 are reported).
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -118,6 +119,7 @@ void pclIcp(benchmark::State& state, double max_corr) {
   runPcl(state, reg);
 }
 
+// The first frame's target: the box crop under the initial guess.
 void targetBuild(benchmark::State& state) {
   const auto& f = fixture();
   const auto& d = f.data.datasets.front();
@@ -128,6 +130,35 @@ void targetBuild(benchmark::State& state) {
     const auto t = calib::buildAugmentedTarget(d, 0, f.sources.front(), f.data.params, to);
     points = t.target->size();
   }
+  state.counters["target_points"] = double(points);
+}
+
+// A later frame's target: only the mapping points near the source under the guess and an estimate (here
+// the truth, which the first frame's ensemble comes within millimetres of).
+void targetBuildNear(benchmark::State& state) {
+  const auto& f = fixture();
+  const auto& d = f.data.datasets.front();
+  calib::AugmentedTargetOptions to;
+  to.num_threads = int(state.range(0));
+  to.near_poses = {d.T_mapping_calib_guess, f.truth};
+  to.near_radius = calib::nearTargetRadius(f.data.params);
+  std::size_t points = 0;
+  for (auto _ : state) {
+    const auto t = calib::buildAugmentedTarget(d, 0, f.sources.front(), f.data.params, to);
+    points = t.target->size();
+  }
+  state.counters["target_points"] = double(points);
+}
+
+// The crop and voxels alone (no Target), box or near.
+void targetCrop(benchmark::State& state) {
+  const auto& f = fixture();
+  const auto& d = f.data.datasets.front();
+  calib::AugmentedTargetOptions to;
+  if (state.range(0) != 0) to.near_poses = {d.T_mapping_calib_guess, f.truth};
+  to.near_radius = calib::nearTargetRadius(f.data.params);
+  std::size_t points = 0;
+  for (auto _ : state) points = calib::augmentedCloud(d, 1, f.sources[1], f.data.params, to).size();
   state.counters["target_points"] = double(points);
 }
 
@@ -227,6 +258,8 @@ int main(int argc, char** argv) {
   add(benchmark::RegisterBenchmark("pcl/icp_coarse", [](benchmark::State& s) { pclIcp(s, 0.5); }));
   add(benchmark::RegisterBenchmark("pcl/icp_fine", [](benchmark::State& s) { pclIcp(s, 0.1); }));
   add(benchmark::RegisterBenchmark("ours/target_build", targetBuild)->Arg(1)->Arg(2));
+  add(benchmark::RegisterBenchmark("ours/target_build_near", targetBuildNear)->Arg(1)->Arg(2));
+  add(benchmark::RegisterBenchmark("ours/target_crop", targetCrop)->ArgName("near")->Arg(0)->Arg(1));
   add(benchmark::RegisterBenchmark("ours/score_all_frames", scoreAll)->Arg(1)->Arg(2));
   add(benchmark::RegisterBenchmark("ours/batched_icp_chain", batched)->Arg(1)->Arg(2));
   add(benchmark::RegisterBenchmark("ours/calibrate_whole_run", wholeRun)->Arg(1)->Arg(2)->Iterations(1));

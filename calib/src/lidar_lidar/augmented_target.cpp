@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "rigcal/calib/lidar_lidar/source_neighbourhood.hpp"
 #include "rigcal/registration/voxel_accumulator.hpp"
 
 namespace rigcal::calib {
@@ -57,6 +58,11 @@ std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& datase
   return picked;
 }
 
+double nearTargetRadius(const config::Parameters& params) {
+  constexpr double kEstimateError = 0.1;
+  return std::max(params.max_corr_dist_coarse, params.calibration_eval_max_corr_distance) + kEstimateError;
+}
+
 registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& dataset, std::size_t frame,
                                         const registration::PointCloud& source, const config::Parameters& params,
                                         const AugmentedTargetOptions& options, std::size_t* clouds_used,
@@ -74,6 +80,12 @@ registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& data
   const double margin = guess.translation().norm();
   box_min.array() -= margin;
   box_max.array() += margin;
+  std::optional<SourceNeighbourhood> near;
+  if (!options.near_poses.empty()) near.emplace(source, options.near_poses, options.near_radius);
+  const auto keep = [&](const Eigen::Vector3d& q) {
+    if (near) return near->contains(q);
+    return (q.array() >= box_min.array()).all() && (q.array() <= box_max.array()).all();
+  };
 
   const Pose T_scan_map = dataset.frames[frame].pairing.T_map_mapping_at_scan.inverse();
   // Each cloud is cropped and voxelised before the next (the same centroids as voxelising the whole crop
@@ -89,7 +101,7 @@ registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& data
     for (std::size_t j = 0; j < s.size(); ++j) {
       const Eigen::Vector4f q = T * Eigen::Vector4f(s.x[j], s.y[j], s.z[j], 1.0F);
       const Eigen::Vector3d qd = q.head<3>().cast<double>();
-      if (!qd.allFinite() || (qd.array() < box_min.array()).any() || (qd.array() > box_max.array()).any()) continue;
+      if (!qd.allFinite() || !keep(qd)) continue;
       cropped.emplace_back(qd.x(), qd.y(), qd.z(), 1.0);
     }
     if (cropped.empty()) continue;

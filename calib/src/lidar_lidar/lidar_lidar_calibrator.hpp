@@ -83,6 +83,9 @@ class Calibrator {
   /// lidar, so that the verdict can check that the frames agree before the deadline cuts the full ensembles.
   void confirmOnFrame(std::size_t k);
 
+  /// What batchedChain over `frames` frames is expected to take, from the ICP fine runs so far (0 before any).
+  [[nodiscard]] double batchedChainEstimate(std::size_t frames) const;
+
   /// Batched ICP over all frames at 0.5 → 0.1 → 0.05 m from `start`.
   void batchedChain(const Pose& start);
 

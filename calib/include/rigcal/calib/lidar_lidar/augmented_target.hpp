@@ -7,8 +7,10 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "rigcal/config/parameters.hpp"
+#include "rigcal/core/pose.hpp"
 #include "rigcal/pipeline/calibration_dataset.hpp"
 #include "rigcal/registration/deadline.hpp"
 #include "rigcal/registration/point_cloud.hpp"
@@ -26,7 +28,17 @@ struct AugmentedTargetOptions {
   /// The crop stops between mapping clouds once this expires and returns an empty cloud: on a busy machine
   /// cropping a dozen clouds takes longer than a short calibration deadline.
   registration::Deadline deadline;
+  /// Once the extrinsic is known to within the registrators' reach: keep only the mapping points within
+  /// near_radius of the source placed by one of these poses (SourceNeighbourhood) instead of the box under
+  /// the initial guess. Empty: the box.
+  std::vector<Pose> near_poses;
+  double near_radius = 0.6;  // nearTargetRadius(params) for the defaults
 };
+
+/// How far from the source a later frame's target must reach: the coarse registrations' correspondence
+/// distance (which covers the score's) plus what the first frame's estimate may still be off at the
+/// farthest source point (a few cm; 0.1 m allowed).
+double nearTargetRadius(const config::Parameters& params);
 
 struct AugmentedTarget {
   std::shared_ptr<const registration::Target> target;  // in the mapping frame at the scan stamp
@@ -40,7 +52,7 @@ std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& datase
                                       const config::Parameters& params, std::size_t max_clouds);
 
 /// The augmented cloud of dataset.frames[frame] (before building the Target), cropped around `source`
-/// placed by the dataset's initial extrinsic. Empty when options.deadline expired during the crop.
+/// placed by the dataset's initial extrinsic (or near it under options.near_poses). Empty when options.deadline expired during the crop.
 registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& dataset, std::size_t frame,
                                         const registration::PointCloud& source, const config::Parameters& params,
                                         const AugmentedTargetOptions& options, std::size_t* clouds_used = nullptr,
