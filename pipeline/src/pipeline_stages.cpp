@@ -51,8 +51,14 @@ void Pipeline::Impl::deskewStage() {
       wake_pairing.signal();
       progress = true;
     }
-    if (!held.empty()) traj.trimBefore(held.front().scan->stamp_ns - kNsPerSec);
-    else if (!traj.empty()) traj.trimBefore(traj.last() - 2 * kNsPerSec);
+    // Real time drops what comes this late anyway. Offline each driver reads the capture on its own
+    // thread and a calibration lidar may come any time behind the mapping lidar: its scans need the poses
+    // of their own time (a trimmed buffer extrapolated them, and selections differed from run to run), and
+    // the poses of a whole drive are small (~140 B a mapping scan).
+    if (realtime) {
+      if (!held.empty()) traj.trimBefore(held.front().scan->stamp_ns - kNsPerSec);
+      else if (!traj.empty()) traj.trimBefore(traj.last() - 2 * kNsPerSec);
+    }
     if (input_ended && traj_ended && held.empty()) {
       q_cal.push(CalItem{0, {}, true});
       wake_pairing.signal();
