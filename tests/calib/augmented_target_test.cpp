@@ -1,9 +1,12 @@
 // The near crop of a later frame's augmented target (SourceNeighbourhood): every mapping point within its
 // radius of the placed source is kept, so the scores and the coarse registrations see what the box crop
-// gave them, on fewer points.
+// gave them, on fewer points. And the window of mapping clouds a frame's target is built from.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "lidar_lidar_sim_dataset.hpp"
 #include "rigcal/calib/lidar_lidar/augmented_target.hpp"
@@ -65,6 +68,54 @@ TEST(AugmentedTarget, NearCropKeepsTheScoresOfItsPosesOnFewerPoints) {
   EXPECT_EQ(scoreFrame(*box.target, source, truth, coarse, 2).inliers,
             scoreFrame(*near.target, source, truth, coarse, 2).inliers);
   test::releaseFlatParkingLot();
+}
+
+}  // namespace
+}  // namespace rigcal::calib
+
+namespace rigcal::calib {
+namespace {
+
+// A trajectory of keyframes with ordinary stored frames between them (keyframe_index -1), one cloud each.
+pipeline::CalibrationDataset keyframesWithFramesBetween(int keyframes, int frames_between) {
+  pipeline::CalibrationDataset d;
+  std::uint64_t sequence = 0;
+  for (int k = 0; k < keyframes; ++k) {
+    for (int j = 0; j <= frames_between; ++j) {
+      pipeline::MappingFrame f;
+      f.sequence = sequence++;
+      f.kind = j == 0 ? pipeline::FrameKind::kKeyframe : pipeline::FrameKind::kFrame;
+      f.keyframe_index = j == 0 ? k : -1;
+      d.trajectory.push_back(f);
+      d.mapping_clouds.push_back({f, std::make_shared<const Scan>()});
+    }
+  }
+  return d;
+}
+
+// The window of a keyframe ±n keyframes reaches back to the start when there are fewer keyframes before it;
+// one keyframe short (lo = -1) it had come out empty: every frame between keyframes has keyframe_index -1
+// (the parking-lot demo's most informative front_left frame was skipped as "0 points from 0 mapping clouds").
+TEST(TargetWindow, AWindowReachingBeforeTheFirstKeyframeStartsAtTheFirstCloud) {
+  config::Parameters params;
+  params.dense_pointcloud_num_keyframes = 3;
+  const int between = 2;
+  pipeline::CalibrationDataset d = keyframesWithFramesBetween(10, between);
+  for (int k = 0; k < 10; ++k) {
+    pipeline::CalibrationFrame frame;
+    frame.pairing.keyframe_frame = std::size_t(k * (between + 1));
+    d.frames.push_back(frame);
+  }
+  for (int k = 0; k < 10; ++k) {
+    const std::vector<std::size_t> window = targetWindow(d, std::size_t(k), params, 0);
+    // From keyframe k-3 (or the first cloud) to keyframe k+3 (or the last cloud), every cloud between.
+    const std::size_t first = std::size_t(std::max(0, k - 3) * (between + 1));
+    const std::size_t last = k + 3 <= 9 ? std::size_t((k + 3) * (between + 1)) : d.mapping_clouds.size() - 1;
+    ASSERT_FALSE(window.empty()) << "keyframe " << k;
+    EXPECT_EQ(window.front(), first) << "keyframe " << k;
+    EXPECT_EQ(window.back(), last) << "keyframe " << k;
+    EXPECT_EQ(window.size(), last - first + 1) << "keyframe " << k;
+  }
 }
 
 }  // namespace

@@ -25,9 +25,12 @@ std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& datase
   const auto& keyframe = dataset.trajectory[pairing.keyframe_frame];
   const int lo = keyframe.keyframe_index - params.dense_pointcloud_num_keyframes;
   const int hi = keyframe.keyframe_index + params.dense_pointcloud_num_keyframes;
-  // The window's sequence range: from keyframe lo (or the start) to keyframe hi (or the end).
+  // The window's sequence range: from keyframe lo (or the start) to keyframe hi (or the end). Only
+  // keyframes count: every other frame's keyframe_index is -1, which a window starting one keyframe
+  // before the first (lo = -1) had matched, leaving it empty.
   std::uint64_t seq_lo = 0, seq_hi = std::numeric_limits<std::uint64_t>::max();
   for (const auto& f : dataset.trajectory) {
+    if (f.keyframe_index < 0) continue;
     if (f.keyframe_index == lo) seq_lo = f.sequence;
     if (f.keyframe_index == hi) seq_hi = f.sequence;
   }
