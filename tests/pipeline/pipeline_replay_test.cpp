@@ -96,6 +96,9 @@ TEST_F(Replayed, TwoOfflineRunsGiveIdenticalFrames) {
 // the trajectory had been trimmed to the last 2 s, so a late scan was deskewed by extrapolating the oldest
 // poses left, and the same recording selected other frames from run to run.
 TEST_F(Replayed, ACalibrationLidarBehindTheMappingLidarIsDeskewedAsIfOnTime) {
+  // Sanitized builds replay 2 s only: too short for a calibration dataset (and for the old 2 s buffer to
+  // have lost any pose).
+  if (RIGCAL_SANITIZED) { GTEST_SKIP() << "a 2 s replay has no calibration dataset"; }
   std::vector<Scan> late;  // every mapping scan first, then every calibration scan
   for (const Scan& s : recorded_.scans)
     if (s.sensor_id != "front_left") late.push_back(s);
@@ -123,8 +126,7 @@ TEST_F(Replayed, ACalibrationLidarBehindTheMappingLidarIsDeskewedAsIfOnTime) {
     }
     EXPECT_EQ(a.frames[i].information, b.frames[i].information);
   }
-  // Sanitized builds replay 2 s only: too short to have frames the old buffer had lost.
-  if (!RIGCAL_SANITIZED) { EXPECT_GT(long_before_the_end, 0u); }
+  EXPECT_GT(long_before_the_end, 0u);
 }
 
 TEST_F(Replayed, RealtimeNeverBlocksTheInputAndCountsDrops) {
