@@ -119,28 +119,15 @@ void pclIcp(benchmark::State& state, double max_corr) {
   runPcl(state, reg);
 }
 
-// The first frame's target: the box crop under the initial guess.
-void targetBuild(benchmark::State& state) {
+// A frame's target build: the first frame's crops the box under the initial guess; a later frame's (`near`)
+// keeps only the mapping points near the source under the guess and an estimate (here the truth, which the
+// first frame's ensemble comes within millimetres of).
+void buildTargets(benchmark::State& state, bool near) {
   const auto& f = fixture();
   const auto& d = f.data.datasets.front();
   calib::AugmentedTargetOptions to;
   to.num_threads = int(state.range(0));
-  std::size_t points = 0;
-  for (auto _ : state) {
-    const auto t = calib::buildAugmentedTarget(d, 0, f.sources.front(), f.data.params, to);
-    points = t.target->size();
-  }
-  state.counters["target_points"] = double(points);
-}
-
-// A later frame's target: only the mapping points near the source under the guess and an estimate (here
-// the truth, which the first frame's ensemble comes within millimetres of).
-void targetBuildNear(benchmark::State& state) {
-  const auto& f = fixture();
-  const auto& d = f.data.datasets.front();
-  calib::AugmentedTargetOptions to;
-  to.num_threads = int(state.range(0));
-  to.near_poses = {d.T_mapping_calib_guess, f.truth};
+  if (near) to.near_poses = {d.T_mapping_calib_guess, f.truth};
   to.near_radius = calib::nearTargetRadius(f.data.params);
   std::size_t points = 0;
   for (auto _ : state) {
@@ -149,6 +136,8 @@ void targetBuildNear(benchmark::State& state) {
   }
   state.counters["target_points"] = double(points);
 }
+void targetBuild(benchmark::State& state) { buildTargets(state, false); }
+void targetBuildNear(benchmark::State& state) { buildTargets(state, true); }
 
 // The crop and voxels alone (no Target), box or near.
 void targetCrop(benchmark::State& state) {
