@@ -15,11 +15,14 @@ void Calibrator::run() {
   best_ = data_.T_mapping_calib_guess;
   // The most informative frame first, alone: its ensemble gives the big correction early.
   std::size_t next = 0;
-  while (frames_.empty() && next < data_.frames.size() && !stopped()) buildFrame(next++);
+  bool out_of_time = false;
+  while (frames_.empty() && next < data_.frames.size() && !out_of_time)
+    out_of_time = stopped() || buildFrame(next++) == FrameBuild::kOutOfTime;
   double target_seconds = since(t0);
   if (frames_.empty()) {
-    out_.failure = out_.deadline_reached ? "deadline reached before any calibration frame's target was built"
-                                         : "no calibration frame has a usable source and target";
+    out_.deadline_reached = out_of_time;
+    out_.failure = out_of_time ? "deadline reached before any calibration frame's target was built"
+                               : "no calibration frame has a usable source and target";
     out_.stage_seconds.emplace_back("targets", target_seconds);
     return;
   }
@@ -32,19 +35,17 @@ void Calibrator::run() {
   // Then every other frame, scored together from now on.
   t = Clock::now();
   const std::size_t first_frames = frames_.size();
-  while (next < data_.frames.size() && !stopped()) {
+  bool targets_cut = false;
+  while (next < data_.frames.size() && !targets_cut) {
     // A frame's whole preparation (crop, voxels, target) as long as the last one's, or it waits; and after
     // it, time for what makes one estimate of the frames: the grown set's rescore (else the new frames are
     // dropped) and the batched chain. Without that reserve a loaded machine spent the whole share on
     // targets and never ran the batched ICP (parking lot at load 7: front_right 1.0-1.3 cm off).
     const double grown_next = double(frames_.size() + 1) / double(first_frames);
     const double reserve = 2.5 * grown_next * score_seconds_ + batchedChainEstimate(frames_.size() + 1);
-    if (!fits(deadline_, 1.2 * last_build_seconds_ + reserve)) {
-      out_.deadline_reached = true;
-      break;
-    }
     const std::size_t built = frames_.size();
-    buildFrame(next++);
+    targets_cut = !fits(deadline_, 1.2 * last_build_seconds_ + reserve) || buildFrame(next++) == FrameBuild::kOutOfTime;
+    if (targets_cut) break;
     target_seconds += since(t);
     // Its own view of the best at once (one ICP), before the next target: if the deadline cuts the
     // targets, the frames built so far still count as evidence for the verdict (lidar_lidar_verdict.hpp).
@@ -56,40 +57,49 @@ void Calibrator::run() {
   target_seconds += since(t);
   // A next target that did not fit ends the targets, not the plan: the frames built so far still get the
   // rescore, the batched chain and their ensembles in the time left (it had skipped all of them: under load
-  // the batched ICP never ran). The plan is marked cut at the end.
-  const bool targets_cut = out_.deadline_reached || next < data_.frames.size();
-  if (out_.deadline_reached && !deadline_.expired()) out_.deadline_reached = false;
-  // Rescoring the guess and the best over the grown set costs two scores of the new size.
-  const double grown = double(frames_.size()) / double(first_frames);
-  if (frames_.size() > first_frames && fits(deadline_, 2.5 * grown * score_seconds_)) rescore();
-  else if (frames_.size() > first_frames) {
-    // No time to score the grown set: keep the frames the scores were computed on.
-    frames_.resize(first_frames);
-    out_.frames_used.resize(first_frames);
-    out_.deadline_reached = true;
+  // the batched ICP never ran).
+  bool plan_cut = targets_cut;
+  // The plan's steps after the targets; each false when it ran out of time (the ones after it are skipped).
+  const auto steps = [&] {
+    // Rescoring the guess and the best over the grown set costs two scores of the new size.
+    const double grown = double(frames_.size()) / double(first_frames);
+    if (frames_.size() > first_frames && !fits(deadline_, 2.5 * grown * score_seconds_)) {
+      // No time to score the grown set: keep the frames the scores were computed on.
+      frames_.resize(first_frames);
+      out_.frames_used.resize(first_frames);
+      return false;
+    }
+    if (frames_.size() > first_frames) rescore();
+    t = Clock::now();
+    if (!stopped()) batchedChain(best_);
+    batched_seconds += since(t);
+    t = Clock::now();
+    for (std::size_t k = 1; k < frames_.size() && !stopped(); ++k) frameEnsemble(k, false);
+    ensemble_seconds += since(t);
+    return !stopped();
+  };
+  double final_seconds = 0.0;
+  if (steps()) {
+    t = Clock::now();
+    const bool finished = finalStep();
+    final_seconds = since(t);
+    plan_cut = plan_cut || !finished;
+    // Here the plan is done: every frame through its ensemble, the batched chain, the re-deskew. Whatever
+    // time is left goes to upstream's exhaustive ensemble (every registrator from every candidate), which
+    // guards against a wrong basin; a better result gets the final batched refinement too. The deadline
+    // ending it does not make the result "the best so far of a cut plan": with it, no default run could
+    // ever finish its plan.
+    t = Clock::now();
+    const Pose before_exhaustive = best_;
+    for (std::size_t k = 0; k < frames_.size() && finished && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
+    if (finished && !samePose(before_exhaustive, best_) && !stopped()) batchedChain(best_);
+    ensemble_seconds += since(t);
+  } else {
+    plan_cut = true;
   }
-  t = Clock::now();
-  if (!stopped()) batchedChain(best_);
-  batched_seconds += since(t);
-  t = Clock::now();
-  for (std::size_t k = 1; k < frames_.size() && !stopped(); ++k) frameEnsemble(k, false);
-  ensemble_seconds += since(t);
-  t = Clock::now();
-  if (!stopped()) finalStep();
-  const double final_seconds = since(t);
-  // Whatever time is left: upstream's exhaustive ensemble (every registrator from every candidate),
-  // which guards against a wrong basin; a better result gets the final batched refinement too.
-  t = Clock::now();
-  // Here the plan is done: every frame through its ensemble, the batched chain, the re-deskew. The
-  // exhaustive pass only searches other basins in the time left, so the deadline ending it does not make the
-  // result "the best so far of a cut plan" (deadline_reached): with it, no default run could ever finish.
-  const bool plan_finished = !stopped() && !targets_cut;
-  const Pose before_exhaustive = best_;
-  for (std::size_t k = 0; k < frames_.size() && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
-  if (!samePose(before_exhaustive, best_) && !stopped()) batchedChain(best_);
-  if (plan_finished && (deadline_.token() == nullptr || !deadline_.token()->cancelled())) out_.deadline_reached = false;
-  if (targets_cut) out_.deadline_reached = true;
-  ensemble_seconds += since(t);
+  // A run cancelled from outside (the user stopping it) is cut wherever it was.
+  const bool cancelled = deadline_.token() != nullptr && deadline_.token()->cancelled();
+  out_.deadline_reached = plan_cut || cancelled;
   out_.stage_seconds = {{"targets", target_seconds},
                         {"ensemble", ensemble_seconds},
                         {"batched", batched_seconds},
@@ -123,10 +133,7 @@ double Calibrator::batchedChainEstimate(std::size_t frames) const {
   return n == 0 ? 0.0 : 3.0 * seconds / double(n) * double(frames);
 }
 
-bool Calibrator::stopped() {
-  if (deadline_.expired()) out_.deadline_reached = true;
-  return out_.deadline_reached;
-}
+bool Calibrator::stopped() const { return deadline_.expired(); }
 
 void Calibrator::rescore() {
   rebuildScorePairs();

@@ -37,6 +37,9 @@ struct Frame {
   std::shared_ptr<const Target> target;
 };
 
+/// What building a frame came to: the frame, a frame skipped for want of points, or no time to build it.
+enum class FrameBuild { kBuilt, kSkipped, kOutOfTime };
+
 class Calibrator {
  public:
   Calibrator(const pipeline::CalibrationDataset& dataset, const config::Parameters& params, const Deadline& deadline,
@@ -49,10 +52,12 @@ class Calibrator {
   [[nodiscard]] const std::vector<Frame>& frames() const { return frames_; }
 
  private:
-  bool stopped();
+  /// The deadline passed (or the run was cancelled): every step stops. Whether that cut the plan is run()'s
+  /// call (out_.deadline_reached): the exhaustive pass at the end only fills the time left.
+  [[nodiscard]] bool stopped() const;
 
   /// Source and augmented target of dataset frame i; a frame without enough points is skipped (noted).
-  void buildFrame(std::size_t i);
+  FrameBuild buildFrame(std::size_t i);
 
   /// The initial guess's and the best's scores over the frames built so far (the set just grew).
   void rescore();
@@ -89,8 +94,9 @@ class Calibrator {
   /// Batched ICP over all frames at 0.5 → 0.1 → 0.05 m from `start`.
   void batchedChain(const Pose& start);
 
-  /// Re-deskews every frame with the best extrinsic, then batched ICP from {initial, best}.
-  void finalStep();
+  /// Re-deskews every frame with the best extrinsic, then batched ICP from {initial, best}; false when the
+  /// deadline cut it.
+  bool finalStep();
 
   const pipeline::CalibrationDataset& data_;
   const config::Parameters& params_;

@@ -132,11 +132,11 @@ void Calibrator::batchedChain(const Pose& start) {
   }
 }
 
-void Calibrator::finalStep() {
+bool Calibrator::finalStep() {
   if (opt_.redeskew && !samePose(best_, data_.T_mapping_calib_guess) && data_.trajectory.size() >= 2) {
     std::vector<PointCloud> sources;
     for (const auto& f : frames_) {
-      if (stopped()) return;
+      if (stopped()) return false;
       const Scan deskewed = deskewThroughMapping(*data_.frames[f.index].raw, data_.trajectory, best_);
       SourceOptions so;
       so.covariances = false;
@@ -145,15 +145,13 @@ void Calibrator::finalStep() {
     for (std::size_t k = 0; k < frames_.size(); ++k) frames_[k].source = std::move(sources[k]);
     rebuildScorePairs();
     // Scores under the new sources are not comparable with the old ones: rescore the best.
-    if (!fits(deadline_, score_seconds_)) {
-      out_.deadline_reached = true;
-      return;
-    }
+    if (!fits(deadline_, score_seconds_)) return false;
     best_score_ = score(best_);
   }
   const Pose best_before = best_;
   batchedChain(data_.T_mapping_calib_guess);
   batchedChain(best_before);
+  return !stopped();
 }
 
 }  // namespace rigcal::calib::detail

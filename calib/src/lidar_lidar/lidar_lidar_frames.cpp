@@ -28,7 +28,7 @@ double firstTargetLeaf(double leaf, double seconds, double allowed) {
 }
 }  // namespace
 
-void Calibrator::buildFrame(std::size_t i) {
+FrameBuild Calibrator::buildFrame(std::size_t i) {
   const auto& df = data_.frames[i];
   std::ostringstream skip;
   skip << "frame " << i << ": ";
@@ -40,12 +40,12 @@ void Calibrator::buildFrame(std::size_t i) {
   so.num_threads = opt_.num_threads;
   f.source = buildSource(*df.deskewed, params_, so);
   // Every step of a frame's preparation that cannot be interrupted is followed by a look at the deadline.
-  if (stopped()) return;
+  if (stopped()) return FrameBuild::kOutOfTime;
   if (f.source.size() < std::size_t(std::max(params_.min_calibration_pointcloud_size, 10))) {
     skip << f.source.size() << " source points within the calibration range (min_calibration_pointcloud_size "
          << params_.min_calibration_pointcloud_size << ")";
     out_.frames_skipped.push_back(skip.str());
-    return;
+    return FrameBuild::kSkipped;
   }
   AugmentedTargetOptions to = opt_.target;
   to.num_threads = opt_.num_threads;
@@ -60,14 +60,11 @@ void Calibrator::buildFrame(std::size_t i) {
   std::size_t clouds = 0, cropped = 0;
   const auto tc = Clock::now();
   auto cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds, &cropped);
-  if (stopped()) return;
+  if (stopped()) return FrameBuild::kOutOfTime;
   // What the first frame still needs (perhaps a voxel pass over these points, a target build over them, a
   // registration) takes longer than the crop did: with less time left, stop now rather than start an uncut
   // voxel pass that overshoots the deadline (a 0.5 s share ended 0.1-0.18 s late on a loaded machine).
-  if (frames_.empty() && !fits(deadline_, since(tc))) {
-    out_.deadline_reached = true;
-    return;
-  }
+  if (frames_.empty() && !fits(deadline_, since(tc))) return FrameBuild::kOutOfTime;
   // The first frame must leave time to register: under a short deadline its target is thinned rather
   // than not built at all. First by coarser voxels over every mapping cloud of the window: dropping clouds
   // (below) leaves holes where no remaining cloud looked, and a tilted lidar looks where a 32-beam map has
@@ -83,17 +80,14 @@ void Calibrator::buildFrame(std::size_t i) {
     const double points_per_cloud = double(dense_points) / double(clouds);  // the rebuild is at the dense leaf
     to.max_clouds = std::max<std::size_t>(1, std::size_t(allowed / (seconds_per_point_ * points_per_cloud)));
     cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds, &cropped);
-    if (stopped()) return;
+    if (stopped()) return FrameBuild::kOutOfTime;
   }
   // Do not start a build that the deadline would cut (wasted work: the build stops at the deadline).
-  if (!fits(deadline_, seconds_per_point_ * double(cloud.size()))) {
-    out_.deadline_reached = true;
-    return;
-  }
+  if (!fits(deadline_, seconds_per_point_ * double(cloud.size()))) return FrameBuild::kOutOfTime;
   if (cloud.size() < 100) {
     skip << "augmented target has " << cloud.size() << " points from " << clouds << " mapping clouds";
     out_.frames_skipped.push_back(skip.str());
-    return;
+    return FrameBuild::kSkipped;
   }
   const double n = double(cloud.size());
   registration::TargetOptions topt;
@@ -102,14 +96,12 @@ void Calibrator::buildFrame(std::size_t i) {
   topt.num_threads = opt_.num_threads;
   topt.deadline = deadline_;  // on a busy machine a build can take several times its estimate
   f.target = std::make_shared<const Target>(std::move(cloud), topt);
-  if (f.target->stopped()) {
-    out_.deadline_reached = true;
-    return;
-  }
+  if (f.target->stopped()) return FrameBuild::kOutOfTime;
   seconds_per_point_ = since(tb) / n;
   last_build_seconds_ = since(tb);
   out_.frames_used.push_back(i);
   frames_.push_back(std::move(f));
+  return FrameBuild::kBuilt;
 }
 
 }  // namespace rigcal::calib::detail
