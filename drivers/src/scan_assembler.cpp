@@ -100,6 +100,7 @@ void ScanAssembler::process(const DecodedPacket& packet) {
 
   if (packet.frame_id) {
     if (frame_id_ && *frame_id_ != *packet.frame_id) emit();
+    noteLag(packet);
     frame_id_ = packet.frame_id;
     pending_lost_ += packet.lost_before;
     pending_.insert(pending_.end(), packet.points.begin(), packet.points.end());
@@ -107,12 +108,20 @@ void ScanAssembler::process(const DecodedPacket& packet) {
   }
 
   pending_lost_ += packet.lost_before;
+  noteLag(packet);  // before the cut below: this packet ends the sweep it emits
   for (std::size_t i = 0; i < packet.points.size(); ++i) {
     const float az = packet.azimuth_deg[i];
     if (last_azimuth_ && crossesCut(*last_azimuth_, az)) emit();
     last_azimuth_ = az;
     pending_.push_back(packet.points[i]);
   }
+}
+
+void ScanAssembler::noteLag(const DecodedPacket& packet) {
+  if (packet.receive_ns == 0 || packet.points.empty()) return;
+  const auto last = std::max_element(packet.points.begin(), packet.points.end(),
+                                     [](const Point& a, const Point& b) { return a.time_ns < b.time_ns; });
+  last_packet_lag_ns_ = packet.receive_ns - last->time_ns;
 }
 
 void ScanAssembler::flush() {

@@ -9,6 +9,7 @@ void pumpScans(PacketSource& source, PacketDecoder& decoder, ScanAssembler& asse
     auto packet = source.next();
     if (packet) {
       decoder.decode(*packet, decoded);
+      decoded.receive_ns = packet->receive_ns;
       assembler.add(std::move(decoded));
     }
     if (keep_going ? !keep_going(!packet) : !packet) break;

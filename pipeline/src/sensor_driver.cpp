@@ -38,12 +38,12 @@ drivers::PacketFilter filterFor(const config::SensorConfig& sensor, bool live) {
 constexpr std::size_t kMaxLags = 4096;  // sweeps kept for the clock-lag median (7 min at 10 Hz)
 }  // namespace
 
-/// Passes packets through and remembers the receive time of the last one (driver thread only). Packets
-/// of another vendor's model (drivers::recognizePacket) are held back and counted as foreign: decoded
-/// with this sensor's layout they would be malformed at best.
-class SensorDriver::ReceiveTimeTap : public drivers::PacketSource {
+/// Passes this sensor's packets through (driver thread only). Packets of another vendor's model
+/// (drivers::recognizePacket) are held back and counted as foreign: decoded with this sensor's layout they
+/// would be malformed at best.
+class SensorDriver::ForeignPacketFilter : public drivers::PacketSource {
  public:
-  ReceiveTimeTap(drivers::PacketSource& inner, drivers::PacketFamily own) : inner_(inner), own_(own) {}
+  ForeignPacketFilter(drivers::PacketSource& inner, drivers::PacketFamily own) : inner_(inner), own_(own) {}
   std::optional<drivers::UdpPacket> next() override {
     auto p = inner_.next();
     while (p && own_ != drivers::PacketFamily::kUnknown) {
@@ -55,12 +55,10 @@ class SensorDriver::ReceiveTimeTap : public drivers::PacketSource {
       foreign.last_source = p->source;
       p = inner_.next();
     }
-    if (p) last_receive_ns = p->receive_ns;
     return p;
   }
   [[nodiscard]] const drivers::SourceStats& stats() const override { return inner_.stats(); }
   [[nodiscard]] std::string warning() const override { return inner_.warning(); }
-  TimeNs last_receive_ns = 0;
   ForeignPackets foreign;
 
  private:
@@ -77,7 +75,8 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
                    // The rig's time_offset_ns puts this sensor's stamps on the rig's clock (before the lag
                    // check, which then measures what is left).
                    scan.stamp_ns -= sensor_.time_offset_ns;
-                   recordLag(scan, tap_ ? tap_->last_receive_ns : 0);
+                   if (const auto lag = assembler_.lastPacketLagNs())
+                     recordLagMs(double(*lag + sensor_.time_offset_ns) * 1e-6);
                    on_scan_(std::move(scan));
                  }),
       stop_(stop),
@@ -120,7 +119,7 @@ SensorDriver::SensorDriver(const config::SensorConfig& sensor, const DriverInput
       else
         source_ = std::make_unique<drivers::UdpSource>(udp);
     }
-    tap_ = std::make_unique<ReceiveTimeTap>(*source_, drivers::familyOfModel(sensor.model));
+    filter_ = std::make_unique<ForeignPacketFilter>(*source_, drivers::familyOfModel(sensor.model));
   } catch (const std::exception& e) {
     throw std::runtime_error("sensor '" + sensor.name + "': " + e.what());
   }
@@ -130,7 +129,7 @@ SensorDriver::~SensorDriver() = default;
 
 void SensorDriver::run(const std::function<void()>& idle) {
   if (clouds_) return runClouds();
-  drivers::pumpScans(*tap_, *decoder_, assembler_, [&](bool was_idle) {
+  drivers::pumpScans(*filter_, *decoder_, assembler_, [&](bool was_idle) {
     if (stop_.load(std::memory_order_relaxed)) return false;
     if (!was_idle) return true;
     if (!live_) return false;  // a pcap that yields nothing has ended
@@ -172,8 +171,12 @@ std::string SensorDriver::warning() const { return clouds_ ? clouds_->warning() 
 void SensorDriver::recordLag(const Scan& scan, TimeNs receive_ns) {
   if (scan.empty() || receive_ns == 0) return;
   const TimeNs end = scan.stamp_ns + *std::max_element(scan.offset_ns.begin(), scan.offset_ns.end());
+  recordLagMs(double(receive_ns - end) * 1e-6);
+}
+
+void SensorDriver::recordLagMs(double lag_ms) {
   std::lock_guard lock(lag_mutex_);
-  if (lags_ms_.size() < kMaxLags) lags_ms_.push_back(double(receive_ns - end) * 1e-6);
+  if (lags_ms_.size() < kMaxLags) lags_ms_.push_back(lag_ms);
 }
 
 std::optional<double> SensorDriver::clockLagMs() const {
@@ -186,7 +189,7 @@ std::optional<double> SensorDriver::clockLagMs() const {
 
 const ForeignPackets& SensorDriver::foreignPackets() const {
   static const ForeignPackets kNone;  // a PointCloud2 sensor has no packets to recognise
-  return tap_ ? tap_->foreign : kNone;
+  return filter_ ? filter_->foreign : kNone;
 }
 
 std::string ForeignPackets::describe(const std::string& model, std::uint16_t port) const {

@@ -33,6 +33,7 @@ struct DecodedPacket {
   Kind kind = Kind::kData;
   std::string error;                    // kMalformed: names the packet field that is wrong
   TimeNs packet_time_ns = 0;            // time of the packet's first firing
+  TimeNs receive_ns = 0;                // when its datagram arrived (pcap record time); 0 = unknown
   std::uint64_t order_key = 0;          // increases in sensor order (sequence / measurement id / time)
   std::uint32_t lost_before = 0;        // packets the decoder knows were lost just before this one
   std::optional<std::uint64_t> frame_id;  // sensor-defined frame number (Ouster), cut on its change
@@ -43,6 +44,7 @@ struct DecodedPacket {
     kind = Kind::kData;
     error.clear();
     packet_time_ns = 0;
+    receive_ns = 0;
     order_key = 0;
     lost_before = 0;
     frame_id.reset();

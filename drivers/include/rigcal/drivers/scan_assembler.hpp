@@ -53,6 +53,11 @@ class ScanAssembler {
   /// still a sweep).
   void flush();
   [[nodiscard]] const AssemblerStats& stats() const { return stats_; }
+  /// Receive time minus last firing of the latest packet with points and a receive time that went into
+  /// a sweep (read it in the scan callback: a packet of the sweep just completed, or the one that ended it).
+  /// The sensor's clock lag, free of how long a sweep waits to be cut and released from the reorder window
+  /// (up to reorder_window + 1 packets: 12 ms for an OS1-64, 1 ms for a VLS-128).
+  [[nodiscard]] std::optional<TimeNs> lastPacketLagNs() const { return last_packet_lag_ns_; }
 
  private:
   [[nodiscard]] bool crossesCut(float from_deg, float to_deg) const;
@@ -60,6 +65,7 @@ class ScanAssembler {
   void hold(std::size_t slot);              // inserts a filled slot into the window
   void releaseOldest();
   void process(const DecodedPacket& packet);
+  void noteLag(const DecodedPacket& packet);
   void emit();
 
   std::string sensor_id_;
@@ -72,6 +78,7 @@ class ScanAssembler {
   std::optional<float> last_azimuth_;
   std::optional<std::uint64_t> frame_id_;
   std::optional<TimeNs> last_packet_time_;
+  std::optional<TimeNs> last_packet_lag_ns_;
   std::uint64_t sequence_ = 0;
 
   // Reorder window: slots_ holds reorder_window + 1 reusable packets; window_ lists the held slots in

@@ -70,9 +70,10 @@ class SensorDriver {
   [[nodiscard]] std::string warning() const;
   /// With a bag: the topic read and its type ("/points (sensor_msgs/msg/PointCloud2)"); empty otherwise.
   [[nodiscard]] const std::string& bagTopic() const { return bag_topic_; }
-  /// The median over sweeps of (capture / receive time of the packet that closed the sweep − the sensor's
-  /// time of the sweep's last point), in ms; nullopt before the first sweep. Sensors whose clocks agree
-  /// show the same lag within the network's and the assembler's few ms (see SensorClockCheck).
+  /// The median over sweeps of (capture / receive time of the sweep's last packet − the sensor's time of that
+  /// packet's last firing), in ms (a PointCloud2 topic: log time − the cloud's last point); nullopt before
+  /// the first sweep. Sensors whose clocks agree show the same lag within the network's few tenths of a ms,
+  /// whatever their packet rates (the packet-clock check of `calibrate`).
   [[nodiscard]] std::optional<double> clockLagMs() const;
   /// Packets of another model held back from the decoder (complete once run() returned).
   [[nodiscard]] const ForeignPackets& foreignPackets() const;
@@ -92,9 +93,10 @@ class SensorDriver {
   double rate_ = 0.0;
   std::string bag_topic_;
   void runClouds();
-  void recordLag(const Scan& scan, TimeNs receive_ns);
-  class ReceiveTimeTap;
-  std::unique_ptr<ReceiveTimeTap> tap_;  // wraps source_: remembers the last packet's receive time
+  void recordLag(const Scan& scan, TimeNs receive_ns);  // a whole cloud received at receive_ns
+  void recordLagMs(double lag_ms);
+  class ForeignPacketFilter;
+  std::unique_ptr<ForeignPacketFilter> filter_;  // wraps source_: holds back and counts other models' packets
   mutable std::mutex lag_mutex_;
   std::vector<double> lags_ms_;  // one per sweep (the first kMaxLags)
 };
