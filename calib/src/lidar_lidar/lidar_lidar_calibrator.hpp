@@ -57,7 +57,8 @@ class Calibrator {
   [[nodiscard]] bool stopped() const;
 
   /// Source and augmented target of dataset frame i; a frame without enough points is skipped (noted).
-  FrameBuild buildFrame(std::size_t i);
+  /// Out of time when the target's build would leave less than `reserve` seconds.
+  FrameBuild buildFrame(std::size_t i, double reserve = 0.0);
 
   /// The initial guess's and the best's scores over the frames built so far (the set just grew).
   void rescore();
@@ -94,8 +95,9 @@ class Calibrator {
   /// Batched ICP over all frames at 0.5 → 0.1 → 0.05 m from `start`.
   void batchedChain(const Pose& start);
 
-  /// Re-deskews every frame with the best extrinsic, then batched ICP from {initial, best}; false when the
-  /// deadline cut it.
+  /// Re-deskews every frame with the best extrinsic, then the batched ICP chain from the best; false when
+  /// the deadline cut it. (Upstream, where this is the last step, also runs the chain from the initial guess
+  /// here: run() does that after the plan, as a search for another basin like the exhaustive pass.)
   bool finalStep();
 
   const pipeline::CalibrationDataset& data_;
@@ -108,7 +110,7 @@ class Calibrator {
   double score_seconds_ = 0.0;
   // Target build cost per point; until measured, a pessimistic guess (measured 2–7 µs on a loaded 2-core box).
   double seconds_per_point_ = 6e-6;
-  double last_build_seconds_ = 0.0;
+  double last_prepare_seconds_ = 0.0;  // the last frame's source and crop, before its target build
   CalibrationScore initial_score_;
   std::set<std::tuple<std::size_t, int, std::size_t>> tried_;  // (frame, registrator, start) runs done
   Pose best_ = Pose::Identity();

@@ -148,9 +148,7 @@ bool Calibrator::finalStep() {
     if (!fits(deadline_, score_seconds_)) return false;
     best_score_ = score(best_);
   }
-  const Pose best_before = best_;
-  batchedChain(data_.T_mapping_calib_guess);
-  batchedChain(best_before);
+  batchedChain(best_);
   return !stopped();
 }
 

@@ -28,7 +28,7 @@ double firstTargetLeaf(double leaf, double seconds, double allowed) {
 }
 }  // namespace
 
-FrameBuild Calibrator::buildFrame(std::size_t i) {
+FrameBuild Calibrator::buildFrame(std::size_t i, double reserve) {
   const auto& df = data_.frames[i];
   std::ostringstream skip;
   skip << "frame " << i << ": ";
@@ -82,8 +82,11 @@ FrameBuild Calibrator::buildFrame(std::size_t i) {
     cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds, &cropped);
     if (stopped()) return FrameBuild::kOutOfTime;
   }
-  // Do not start a build that the deadline would cut (wasted work: the build stops at the deadline).
-  if (!fits(deadline_, seconds_per_point_ * double(cloud.size()))) return FrameBuild::kOutOfTime;
+  // Do not start a build that the deadline would cut (wasted work: the build stops at the deadline), nor
+  // one that leaves less than `reserve`. Judged on the cropped cloud: a later frame's near crop is a
+  // fraction of the first frame's box (the street's VLP-16 behind a VLS-128 map).
+  const double prepare_seconds = since(tb);
+  if (!fits(deadline_, seconds_per_point_ * double(cloud.size()) + reserve)) return FrameBuild::kOutOfTime;
   if (cloud.size() < 100) {
     skip << "augmented target has " << cloud.size() << " points from " << clouds << " mapping clouds";
     out_.frames_skipped.push_back(skip.str());
@@ -95,10 +98,11 @@ FrameBuild Calibrator::buildFrame(std::size_t i) {
   topt.ndt_resolutions = {to.ndt_resolution};
   topt.num_threads = opt_.num_threads;
   topt.deadline = deadline_;  // on a busy machine a build can take several times its estimate
+  const auto tt = Clock::now();
   f.target = std::make_shared<const Target>(std::move(cloud), topt);
   if (f.target->stopped()) return FrameBuild::kOutOfTime;
-  seconds_per_point_ = since(tb) / n;
-  last_build_seconds_ = since(tb);
+  seconds_per_point_ = since(tt) / n;
+  last_prepare_seconds_ = prepare_seconds;
   out_.frames_used.push_back(i);
   frames_.push_back(std::move(f));
   return FrameBuild::kBuilt;
