@@ -13,7 +13,9 @@
 //                (sim 63 s, calibrate 230 s; lidar-lidar took 120 s of its 60 s deadline, two batches)
 //                with one deadline for all lidars: lidar-lidar 60.1 s, 20.0 / 20.0 / 19.9 s shares; rear 0.053 cm
 //                0.005°, front 0.20 cm 0.001°, left 0.070 cm 0.007°; base 0.003 cm, 0.009° (sim 62 s,
-//                calibrate 137 s, load 4-6)
+//                calibrate 137 s, load 4-6); at the default 10 s deadline (the preset's since session 12): every
+//                lidar ok (dl), rear 0.10 cm 0.001°, front 0.09-0.37 cm 0.001-0.028°, left 0.15-0.17 cm
+//                0.006-0.009° (two runs of calibrate on one capture, load 5-6)
 //   lost         front_left 0.25 cm 0.014°; base 0.05 cm, 0.016° (sim 21 s, calibrate 39 s)
 // The `pose` preset has no calibration lidar (one VLP-16 and an INS; see calibrate_pose_cli_test.cpp), and
 // its ±15° roll / ±12° pitch excitation tilts base_link over the ground on purpose, so base-lidar is not
