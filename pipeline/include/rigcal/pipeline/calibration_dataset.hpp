@@ -27,7 +27,9 @@ struct MappingCloud {
 struct CalibrationFrame {
   Pairing pairing;                       // keyframe, scan stamp, T_map_mapping_at_scan, statistics
   std::shared_ptr<const Scan> raw;       // the calibration lidar's scan as decoded (own frame, skewed)
-  std::shared_ptr<const Scan> deskewed;  // deskewed through the initial extrinsic, own frame at scan stamp
+  /// Deskewed through the initial extrinsic, own frame at scan stamp, cropped (calibration_crop.hpp):
+  /// positions only (x, y, z; the other arrays empty: never point(), filter()).
+  std::shared_ptr<const Scan> deskewed;
   double information = 0.0;              // pcaInformation() of `deskewed`
   /// The mapping clouds its target is built from: indices into CalibrationDataset::mapping_clouds, by
   /// sequence (spreadWindowPicks() over its window, target_window_picks.hpp). Empty: every mapping cloud
