@@ -14,11 +14,22 @@ namespace reg = registration;
 
 namespace {
 
-std::shared_ptr<const reg::Target> buildTarget(const std::vector<std::shared_ptr<const reg::PointCloud>>& clouds,
-                                               const config::Parameters& params, bool use_ndt, int threads) {
+/// The keyframes' points one after the other, homogeneous again (w = 1, as they were transformed).
+template <class Clouds>
+reg::PointCloud concatenated(const Clouds& clouds) {
+  std::size_t n = 0;
+  for (const auto& k : clouds) n += k->size();
   reg::PointCloud merged;
-  for (const auto& k : clouds) merged.points.insert(merged.points.end(), k->points.begin(), k->points.end());
-  merged = reg::voxelDownsample(merged, params.leaf_size_local_map);
+  merged.points.reserve(n);
+  for (const auto& k : clouds)
+    for (const Eigen::Vector3d& p : *k) merged.points.emplace_back(p.x(), p.y(), p.z(), 1.0);
+  return merged;
+}
+
+template <class Clouds>
+std::shared_ptr<const reg::Target> buildTarget(const Clouds& clouds, const config::Parameters& params, bool use_ndt,
+                                               int threads) {
+  reg::PointCloud merged = reg::voxelDownsample(concatenated(clouds), params.leaf_size_local_map);
   reg::TargetOptions o;
   o.num_threads = threads;
   if (use_ndt) o.ndt_resolutions = {params.mapper_resolution};
@@ -49,9 +60,11 @@ void LocalMap::swapInPendingTarget(bool now) {
 }
 
 void LocalMap::addKeyframe(const Scan& deskewed, const Pose& T_map_lidar, bool restart) {
-  reg::PointCloud c = reg::voxelDownsample(reg::fromScan(deskewed), params_.leaf_size_local_map);
-  auto k = std::make_shared<reg::PointCloud>(reg::transformed(c, T_map_lidar));
-  k->clearAttributes();
+  const reg::PointCloud c =
+      reg::transformed(reg::voxelDownsample(reg::fromScan(deskewed), params_.leaf_size_local_map), T_map_lidar);
+  auto k = std::make_shared<std::vector<Eigen::Vector3d>>();
+  k->reserve(c.size());
+  for (const auto& p : c.points) k->push_back(p.head<3>());
   if (restart) local_.clear();
   all_keyframes_.push_back(k);
   local_.push_back(std::move(k));
@@ -90,10 +103,6 @@ void LocalMap::launchBuild() {
   });
 }
 
-reg::PointCloud LocalMap::allKeyframes() const {
-  reg::PointCloud merged;
-  for (const auto& k : all_keyframes_) merged.points.insert(merged.points.end(), k->points.begin(), k->points.end());
-  return merged;
-}
+reg::PointCloud LocalMap::allKeyframes() const { return concatenated(all_keyframes_); }
 
 }  // namespace rigcal::pipeline

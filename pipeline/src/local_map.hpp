@@ -35,7 +35,9 @@ class LocalMap {
   [[nodiscard]] registration::PointCloud allKeyframes() const;
 
  private:
-  using KeyframeCloud = std::shared_ptr<const registration::PointCloud>;
+  /// A keyframe's voxelised cloud in the map frame: positions only, without the homogeneous w (always 1),
+  /// three quarters of a PointCloud's bytes; a drive keeps every keyframe for the map (issue #18).
+  using KeyframeCloud = std::shared_ptr<const std::vector<Eigen::Vector3d>>;
 
   void swapInPendingTarget(bool now);
   void launchBuild();

@@ -12,6 +12,19 @@ namespace rigcal::pipeline {
 namespace {
 constexpr TimeNs kRealtimeGiveUpNs = 2 * kNsPerSec;  // real time: a lidar silent this long after a keyframe
 constexpr TimeNs kKeepBeforeNs = 500 * kNsPerMs;     // scans kept before the oldest time still pairable
+
+/// Calibration reads a candidate's cropped cloud as positions only; a lane holds one for every candidate
+/// that may still be selected (issue #18): without the other arrays and the capacity the crop left, a
+/// third of the bytes.
+void keepPositionsOnly(Scan& s) {
+  s.intensity = {};
+  s.ring = {};
+  s.offset_ns = {};
+  s.return_index = {};
+  s.x.shrink_to_fit();
+  s.y.shrink_to_fit();
+  s.z.shrink_to_fit();
+}
 }  // namespace
 
 PairingLane::PairingLane(int lane, const config::Parameters& params, const Pose& T_mapping_calib, bool realtime)
@@ -93,6 +106,7 @@ PairingLane::Step PairingLane::pairNext(const MappingView& view, std::vector<Can
     } else {
       c.information = pcaInformation(*cropped);
       if (params_.calibration_frame_ranking != "pca") c.planes = frameInformation(*cropped);
+      keepPositionsOnly(*cropped);
       c.deskewed = std::move(cropped);
     }
   }

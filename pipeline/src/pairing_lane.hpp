@@ -29,7 +29,9 @@ struct DeskewedScan {
 struct CandidateMessage {
   int lane = 0;
   Pairing pairing;
-  std::shared_ptr<const Scan> raw, deskewed;  // deskewed: cropped, as stored in the dataset
+  std::shared_ptr<const Scan> raw;
+  /// Cropped, as stored in the dataset: positions only (x, y, z; the other arrays empty).
+  std::shared_ptr<const Scan> deskewed;
   double information = 0.0;                   // pcaInformation() of deskewed
   registration::PointToPlaneInformation planes;  // frameInformation() of deskewed (ranking "information")
   int keyframe_index = 0;

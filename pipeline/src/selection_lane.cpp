@@ -18,21 +18,47 @@ std::shared_ptr<const CalibrationDataset> SelectionLane::add(CandidateMessage ca
   last_keyframe_ = std::max(last_keyframe_, candidate.keyframe_index);
   if (handed_over_) return nullptr;  // counted, no longer selected
   lost_keyframes_ = candidate.lost_keyframes;  // grows with every candidate
+  if (candidate.frames) trajectory_ = candidate.frames;
   Record r;
-  const bool selectable = candidate.pairing.accepted && candidate.information >= params_.calibration_min_pca_eigenvalue;
-  if (candidate.pairing.accepted) ++accepted_;
-  if (selectable) {
-    for (std::size_t i = candidate.window_begin; i <= candidate.window_end && i < candidate.frames->size(); ++i) {
-      const MappingFrame& f = (*candidate.frames)[i];
-      if (auto cloud = clouds(i)) r.window.push_back({i, MappingCloud{f, std::move(cloud)}});
-    }
-  }
   r.c = std::move(candidate);
+  const bool selectable = r.c.pairing.accepted && r.c.information >= params_.calibration_min_pca_eigenvalue;
+  if (r.c.pairing.accepted) ++accepted_;
+  if (selectable) r.window = windowPicks(r.c, clouds);
+  else release(r);
+  r.c.frames.reset();  // a snapshot per candidate would add up over a drive: trajectory_ is the one needed
   records_.push_back(std::move(r));
   if (!records_.back().c.pairing.accepted) return nullptr;
   reselect();
   if (!selection_.budgetFull(params_)) return nullptr;
   return handOver(true);
+}
+
+std::vector<std::pair<std::size_t, MappingCloud>> SelectionLane::windowPicks(const CandidateMessage& c,
+                                                                             const CloudLookup& clouds) {
+  const std::vector<MappingFrame>* frames = c.frames.get();
+  std::vector<std::pair<std::size_t, std::shared_ptr<const Scan>>> stored;  // the whole window, briefly
+  std::size_t own = SIZE_MAX;
+  if (frames == nullptr) return {};
+  for (std::size_t i = c.window_begin; i <= c.window_end && i < frames->size(); ++i) {
+    auto cloud = clouds(i);
+    if (!cloud) continue;
+    if (i == c.pairing.keyframe_frame) own = stored.size();
+    stored.emplace_back(i, std::move(cloud));
+  }
+  std::vector<std::pair<std::size_t, MappingCloud>> picked;
+  for (const std::size_t k : spreadWindowPicks(stored.size(), own, kTargetWindowClouds)) {
+    auto& [i, cloud] = stored[k];
+    picked.push_back({i, MappingCloud{(*frames)[i], std::move(cloud)}});
+  }
+  return picked;
+}
+
+void SelectionLane::release(Record& r) {
+  r.window.clear();
+  r.window.shrink_to_fit();
+  r.c.raw.reset();
+  r.c.deskewed.reset();
+  r.c.frames.reset();
 }
 
 void SelectionLane::reselect() {
@@ -42,11 +68,11 @@ void SelectionLane::reselect() {
     if (c.pairing.accepted) pool.push_back({id, c.keyframe_index, c.path_length, c.information, c.planes});
   }
   selection_ = selectFrames(pool, lost_keyframes_, params_);
-  // Too flat or near a lost keyframe stays so: those candidates' clouds can go.
+  // Too flat or near a lost keyframe stays so: those candidates' scans and clouds can go.
   for (const Rejection& r : selection_.rejected) {
     Record& rec = records_[r.id];
     if (rec.c.information < params_.calibration_min_pca_eigenvalue || r.reason.rfind("within ", 0) == 0)
-      rec.window.clear();
+      release(rec);
   }
 }
 
@@ -58,8 +84,10 @@ std::shared_ptr<const CalibrationDataset> SelectionLane::finish() {
 std::shared_ptr<const CalibrationDataset> SelectionLane::handOver(bool budget_full) {
   handed_over_ = true;
   auto d = dataset(budget_full);
-  // The dataset holds the selected windows; no other dataset will come from this lane: the rest can go.
-  for (Record& r : records_) r.window.clear();
+  // The dataset holds the selected frames' scans and clouds; no other dataset will come from this lane:
+  // every candidate is only counted from now on.
+  for (Record& r : records_) release(r);
+  trajectory_.reset();
   return d;
 }
 
@@ -74,13 +102,20 @@ std::shared_ptr<const CalibrationDataset> SelectionLane::dataset(bool budget_ful
   for (const Rejection& r : selection_.rejected) d->rejected.push_back(r);
   std::sort(d->rejected.begin(), d->rejected.end(), [](const Rejection& a, const Rejection& b) { return a.id < b.id; });
   std::map<std::size_t, MappingCloud> window;  // by stored index: in sequence order, each once
+  for (std::size_t id : selection_.selected)
+    for (const auto& [idx, m] : records_[id].window) window.emplace(idx, m);
+  std::map<std::size_t, std::size_t> position;  // stored index → index into mapping_clouds
+  for (auto& [idx, m] : window) {
+    position.emplace(idx, d->mapping_clouds.size());
+    d->mapping_clouds.push_back(m);
+  }
   for (std::size_t id : selection_.selected) {
     const Record& r = records_[id];
-    d->frames.push_back({r.c.pairing, r.c.raw, r.c.deskewed, r.c.information});
-    for (const auto& [idx, m] : r.window) window.emplace(idx, m);
+    CalibrationFrame f{r.c.pairing, r.c.raw, r.c.deskewed, r.c.information, {}};
+    for (const auto& entry : r.window) f.window.push_back(position.at(entry.first));
+    d->frames.push_back(std::move(f));
   }
-  for (auto& [idx, m] : window) d->mapping_clouds.push_back(m);
-  if (!records_.empty()) d->trajectory = *records_.back().c.frames;
+  if (trajectory_) d->trajectory = *trajectory_;
   return d;
 }
 

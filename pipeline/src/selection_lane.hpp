@@ -1,8 +1,10 @@
 #pragma once
 // The selector stage's work for one calibration lidar: keeps every candidate pairing, re-runs
 // selectFrames() when an accepted one arrives, and builds the CalibrationDataset once the frame budget
-// is full (or at end of input with at least lidar_calibration_min_frames). Candidates hold their dense
-// window's clouds until they can never be selected.
+// is full (or at end of input with at least lidar_calibration_min_frames). A candidate that may still be
+// selected holds its scans and the clouds its target would be built from (spreadWindowPicks() of its
+// dense window, at most kTargetWindowClouds); one that can never be (not accepted, too flat, near a lost
+// keyframe, or any after the hand-over) keeps only its pairing, for the dataset's account of candidates.
 #include <functional>
 #include <memory>
 #include <optional>
@@ -41,9 +43,14 @@ class SelectionLane {
 
  private:
   struct Record {
-    CandidateMessage c;
-    std::vector<std::pair<std::size_t, MappingCloud>> window;  // by stored index; released when the candidate can never be selected
+    CandidateMessage c;  // c.frames is reset: the lane keeps the latest snapshot only (trajectory_)
+    std::vector<std::pair<std::size_t, MappingCloud>> window;  // its target's clouds, by stored index
   };
+  /// The clouds of the candidate's dense window its target would be built from.
+  static std::vector<std::pair<std::size_t, MappingCloud>> windowPicks(const CandidateMessage& c,
+                                                                        const CloudLookup& clouds);
+  /// A candidate that can never be selected: only its pairing is kept.
+  static void release(Record& r);
   void reselect();
   std::shared_ptr<const CalibrationDataset> dataset(bool budget_full) const;
   /// The dataset, once; then releases every record's window clouds.
@@ -52,6 +59,7 @@ class SelectionLane {
   CalibrationDataset base_;
   config::Parameters params_;
   std::vector<Record> records_;
+  std::shared_ptr<const std::vector<MappingFrame>> trajectory_;  // the latest candidate's stored frames
   std::vector<int> lost_keyframes_;
   Selection selection_;
   std::size_t accepted_ = 0;

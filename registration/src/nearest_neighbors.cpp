@@ -101,10 +101,8 @@ KdTree::KdTree(std::span<const Eigen::Vector4d> points, const KdTreeOptions& opt
 }
 
 void KdTree::useLeafOrderIndices() {
-  for (std::size_t i = 0; i < index_.size(); ++i) {
-    index_[i] = static_cast<std::uint32_t>(i);
-    where_[i] = static_cast<std::uint32_t>(i);
-  }
+  std::vector<std::uint32_t>().swap(index_);
+  std::vector<std::uint32_t>().swap(where_);
 }
 
 Eigen::Vector4f KdTree::local(const Eigen::Vector4d& q) const {
@@ -207,8 +205,8 @@ bool KdTree::nearest(const Eigen::Vector4d& q, double max_sq_distance, Neighbor*
   if (points_.empty()) return false;
   const Eigen::Vector4f ql = local(q);
   Neighbor best{std::numeric_limits<std::uint32_t>::max(), toFloat(max_sq_distance)};
-  if (hint < where_.size()) {
-    const std::uint32_t h = where_[hint];
+  if (hint < points_.size()) {
+    const std::uint32_t h = leafPosition(hint);
     const float d = (points_[h] - ql).squaredNorm();
     if (d < best.sq_distance) best = {h, d};
   }
@@ -216,7 +214,7 @@ bool KdTree::nearest(const Eigen::Vector4d& q, double max_sq_distance, Neighbor*
   NearestSet set{best.index, best.sq_distance, 1.0F / (scale * scale)};
   search(ql, set);
   if (set.index == std::numeric_limits<std::uint32_t>::max()) return false;
-  *out = {index_[set.index], set.d};
+  *out = {originalIndex(set.index), set.d};
   return true;
 }
 
@@ -255,12 +253,13 @@ std::size_t KdTree::knn(const Eigen::Vector4d& q, std::size_t k, Neighbor* out, 
   } else {
     KnnSet<true> set{{out, k, 0, toFloat(max_sq_distance)}};
     for (const std::uint32_t h : hints) {
-      if (h < where_.size()) set.offer(where_[h], (points_[where_[h]] - ql).squaredNorm());
+      if (h < points_.size()) set.offer(leafPosition(h), (points_[leafPosition(h)] - ql).squaredNorm());
     }
     search(ql, set);
     count = set.top.count;
   }
-  for (std::size_t i = 0; i < count; ++i) out[i].index = index_[out[i].index];
+  if (!index_.empty())
+    for (std::size_t i = 0; i < count; ++i) out[i].index = index_[out[i].index];
   return count;
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -115,6 +116,61 @@ TEST(TargetWindow, AWindowReachingBeforeTheFirstKeyframeStartsAtTheFirstCloud) {
     EXPECT_EQ(window.front(), first) << "keyframe " << k;
     EXPECT_EQ(window.back(), last) << "keyframe " << k;
     EXPECT_EQ(window.size(), last - first + 1) << "keyframe " << k;
+  }
+}
+
+}  // namespace
+}  // namespace rigcal::calib
+
+namespace rigcal::calib {
+namespace {
+
+// The pipeline hands over only the clouds each selected frame's target is built from (its `window`),
+// not every stored frame of its keyframe's ±N window: the target of each frame is made of the same
+// clouds as from the whole windows, although another frame's picks now lie within its sequence range.
+TEST(TargetWindow, AFramesPipelinePickedWindowGivesTheSameCloudsAsItsWholeWindow) {
+  config::Parameters params;
+  params.dense_pointcloud_num_keyframes = 3;
+  const int between = 9;
+  const pipeline::CalibrationDataset whole = keyframesWithFramesBetween(12, between);
+  pipeline::CalibrationDataset picked = whole;
+  picked.mapping_clouds.clear();
+  std::map<std::uint64_t, std::size_t> position;  // sequence → index in picked.mapping_clouds
+  std::vector<std::vector<std::uint64_t>> expected;
+  pipeline::CalibrationDataset with_frames = whole;
+  for (const int k : {4, 6}) {  // overlapping windows (keyframes 1..7 and 3..9)
+    pipeline::CalibrationFrame frame;
+    frame.pairing.keyframe_frame = std::size_t(k * (between + 1));
+    with_frames.frames.push_back(frame);
+  }
+  for (std::size_t f = 0; f < with_frames.frames.size(); ++f) {
+    std::vector<std::uint64_t> sequences;
+    for (const std::size_t i : targetWindow(with_frames, f, params, pipeline::kTargetWindowClouds))
+      sequences.push_back(whole.mapping_clouds[i].frame.sequence);
+    ASSERT_EQ(sequences.size(), pipeline::kTargetWindowClouds) << "a 61-cloud window";
+    for (const std::uint64_t s : sequences) position[s] = 0;
+    expected.push_back(sequences);
+  }
+  for (auto& [sequence, index] : position) {
+    index = picked.mapping_clouds.size();
+    picked.mapping_clouds.push_back(whole.mapping_clouds[std::size_t(sequence)]);
+  }
+  for (std::size_t f = 0; f < with_frames.frames.size(); ++f) {
+    pipeline::CalibrationFrame frame = with_frames.frames[f];
+    for (const std::uint64_t s : expected[f]) frame.window.push_back(position.at(s));
+    picked.frames.push_back(frame);
+  }
+  ASSERT_LT(picked.mapping_clouds.size(), 2 * pipeline::kTargetWindowClouds) << "the windows share picks";
+  for (std::size_t f = 0; f < picked.frames.size(); ++f) {
+    std::vector<std::uint64_t> sequences;
+    for (const std::size_t i : targetWindow(picked, f, params, pipeline::kTargetWindowClouds))
+      sequences.push_back(picked.mapping_clouds[i].frame.sequence);
+    EXPECT_EQ(sequences, expected[f]) << "frame " << f;
+    // A deadline that allows fewer clouds spreads them over the frame's picks, its keyframe's among them.
+    const auto fewer = targetWindow(picked, f, params, 4);
+    ASSERT_EQ(fewer.size(), 4u);
+    const std::uint64_t own = picked.trajectory[picked.frames[f].pairing.keyframe_frame].sequence;
+    EXPECT_TRUE(std::any_of(fewer.begin(), fewer.end(), [&](std::size_t i) { return picked.mapping_clouds[i].frame.sequence == own; }));
   }
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rigcal/calib/lidar_lidar/source_neighbourhood.hpp"
+#include "rigcal/pipeline/target_window_picks.hpp"
 #include "rigcal/registration/voxel_accumulator.hpp"
 
 namespace rigcal::calib {
@@ -23,41 +24,38 @@ std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& datase
     throw std::invalid_argument(msg.str());
   }
   const auto& keyframe = dataset.trajectory[pairing.keyframe_frame];
-  const int lo = keyframe.keyframe_index - params.dense_pointcloud_num_keyframes;
-  const int hi = keyframe.keyframe_index + params.dense_pointcloud_num_keyframes;
-  // The window's sequence range: from keyframe lo (or the start) to keyframe hi (or the end). Only
-  // keyframes count: every other frame's keyframe_index is -1, which a window starting one keyframe
-  // before the first (lo = -1) had matched, leaving it empty.
-  std::uint64_t seq_lo = 0, seq_hi = std::numeric_limits<std::uint64_t>::max();
-  for (const auto& f : dataset.trajectory) {
-    if (f.keyframe_index < 0) continue;
-    if (f.keyframe_index == lo) seq_lo = f.sequence;
-    if (f.keyframe_index == hi) seq_hi = f.sequence;
-  }
   std::vector<std::size_t> window;
   std::size_t own = std::numeric_limits<std::size_t>::max();
-  for (std::size_t i = 0; i < dataset.mapping_clouds.size(); ++i) {
-    const auto& c = dataset.mapping_clouds[i];
-    if (c.cloud == nullptr || c.frame.sequence < seq_lo || c.frame.sequence > seq_hi) continue;
+  const auto consider = [&](std::size_t i) {
+    const auto& c = dataset.mapping_clouds.at(i);
+    if (c.cloud == nullptr) return;
     if (c.frame.sequence == keyframe.sequence) own = window.size();
     window.push_back(i);
+  };
+  const auto& picked_by_pipeline = dataset.frames[frame].window;
+  if (!picked_by_pipeline.empty()) {
+    // The pipeline kept only the clouds this frame's target is built from (the same spread as below).
+    for (const std::size_t i : picked_by_pipeline) consider(i);
+  } else {
+    const int lo = keyframe.keyframe_index - params.dense_pointcloud_num_keyframes;
+    const int hi = keyframe.keyframe_index + params.dense_pointcloud_num_keyframes;
+    // The window's sequence range: from keyframe lo (or the start) to keyframe hi (or the end). Only
+    // keyframes count: every other frame's keyframe_index is -1, which a window starting one keyframe
+    // before the first (lo = -1) had matched, leaving it empty.
+    std::uint64_t seq_lo = 0, seq_hi = std::numeric_limits<std::uint64_t>::max();
+    for (const auto& f : dataset.trajectory) {
+      if (f.keyframe_index < 0) continue;
+      if (f.keyframe_index == lo) seq_lo = f.sequence;
+      if (f.keyframe_index == hi) seq_hi = f.sequence;
+    }
+    for (std::size_t i = 0; i < dataset.mapping_clouds.size(); ++i) {
+      const auto& c = dataset.mapping_clouds[i];
+      if (c.frame.sequence >= seq_lo && c.frame.sequence <= seq_hi) consider(i);
+    }
   }
-  if (max_clouds == 0 || window.size() <= max_clouds) return window;
   // Evenly spread picks, the keyframe's own cloud always among them.
   std::vector<std::size_t> picked;
-  const std::size_t gaps = std::max<std::size_t>(max_clouds - 1, 1);
-  for (std::size_t k = 0; k < max_clouds; ++k) picked.push_back(window[k * (window.size() - 1) / gaps]);
-  if (own < window.size() && std::find(picked.begin(), picked.end(), window[own]) == picked.end()) {
-    // Replace the nearest pick by the keyframe's own cloud.
-    auto nearest = std::min_element(picked.begin(), picked.end(), [&](std::size_t a, std::size_t b) {
-      const auto da = a > window[own] ? a - window[own] : window[own] - a;
-      const auto db = b > window[own] ? b - window[own] : window[own] - b;
-      return da < db;
-    });
-    *nearest = window[own];
-  }
-  std::sort(picked.begin(), picked.end());
-  picked.erase(std::unique(picked.begin(), picked.end()), picked.end());
+  for (const std::size_t k : pipeline::spreadWindowPicks(window.size(), own, max_clouds)) picked.push_back(window[k]);
   return picked;
 }
 

@@ -46,6 +46,11 @@ std::string validateDataset(const pipeline::CalibrationDataset& d, const config:
           << " is not a keyframe of the trajectory";
       return msg.str();
     }
+    for (const std::size_t c : f.window)
+      if (c >= d.mapping_clouds.size()) {
+        msg << who << ": frames[" << i << "].window names mapping cloud " << c << " of " << d.mapping_clouds.size();
+        return msg.str();
+      }
   }
   return {};
 }

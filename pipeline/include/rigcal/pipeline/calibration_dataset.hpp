@@ -13,6 +13,7 @@
 #include "rigcal/pipeline/frame_selector.hpp"
 #include "rigcal/pipeline/mapping_frame.hpp"
 #include "rigcal/pipeline/pairing.hpp"
+#include "rigcal/pipeline/target_window_picks.hpp"
 
 namespace rigcal::pipeline {
 
@@ -26,8 +27,14 @@ struct MappingCloud {
 struct CalibrationFrame {
   Pairing pairing;                       // keyframe, scan stamp, T_map_mapping_at_scan, statistics
   std::shared_ptr<const Scan> raw;       // the calibration lidar's scan as decoded (own frame, skewed)
-  std::shared_ptr<const Scan> deskewed;  // deskewed through the initial extrinsic, own frame at scan stamp
+  /// Deskewed through the initial extrinsic, own frame at scan stamp, cropped (calibration_crop.hpp):
+  /// positions only (x, y, z; the other arrays empty: never point(), filter()).
+  std::shared_ptr<const Scan> deskewed;
   double information = 0.0;              // pcaInformation() of `deskewed`
+  /// The mapping clouds its target is built from: indices into CalibrationDataset::mapping_clouds, by
+  /// sequence (spreadWindowPicks() over its window, target_window_picks.hpp). Empty: every mapping cloud
+  /// between its keyframe's kid±N keyframes (a dataset made by hand).
+  std::vector<std::size_t> window;
 };
 
 struct CalibrationDataset {
@@ -38,8 +45,9 @@ struct CalibrationDataset {
   /// The mapper's whole trajectory so far (poses only, small): lets calibration re-deskew `raw` with
   /// the calibrated extrinsic.
   std::vector<MappingFrame> trajectory;
-  /// Every stored mapping frame within ±dense_pointcloud_num_keyframes of a selected keyframe, by
-  /// sequence; pairing.keyframe_frame indexes `trajectory`.
+  /// The mapping clouds the selected frames' targets are built from (each frame's `window`), by sequence,
+  /// each once: at most kTargetWindowClouds per frame, picked from the stored mapping frames within
+  /// ±dense_pointcloud_num_keyframes keyframes of its keyframe. pairing.keyframe_frame indexes `trajectory`.
   std::vector<MappingCloud> mapping_clouds;
   std::vector<CalibrationFrame> frames;  // selected, most informative first
   std::vector<Rejection> rejected;       // every other candidate and why (ids index `candidates`)

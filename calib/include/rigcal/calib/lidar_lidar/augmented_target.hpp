@@ -21,8 +21,10 @@ namespace rigcal::calib {
 struct AugmentedTargetOptions {
   /// At most this many mapping clouds per target, evenly spread over the window (always keeping the
   /// keyframe's own): a stored frame every few centimetres of path gives ~150 clouds per window, most
-  /// of them redundant after voxelising; 0 = all.
-  std::size_t max_clouds = 12;
+  /// of them redundant after voxelising; 0 = all. The pipeline hands over only the
+  /// pipeline::kTargetWindowClouds a frame's target takes (CalibrationFrame::window): more than that
+  /// picks nothing more, fewer spreads over those.
+  std::size_t max_clouds = pipeline::kTargetWindowClouds;
   double ndt_resolution = 1.0;  // the ensemble's NDT grid
   int num_threads = 1;
   /// The crop stops between mapping clouds once this expires and returns an empty cloud: on a busy machine
@@ -46,7 +48,9 @@ struct AugmentedTarget {
   std::size_t points_before_voxel = 0;  // after the crop
 };
 
-/// Which dataset.mapping_clouds form the window of dataset.frames[frame] (indices, by sequence).
+/// Which dataset.mapping_clouds form the window of dataset.frames[frame] (indices, by sequence): the
+/// frame's own `window` when the pipeline gave one, else every cloud between keyframes kid±N; then at most
+/// max_clouds of them (spreadWindowPicks()).
 /// Throws std::invalid_argument when the frame's keyframe is not a keyframe of dataset.trajectory.
 std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& dataset, std::size_t frame,
                                       const config::Parameters& params, std::size_t max_clouds);
