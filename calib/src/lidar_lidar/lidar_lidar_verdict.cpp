@@ -48,12 +48,19 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
   }
   const auto near = [&](const Distance& d) { return d.m <= opt.agree_m && d.deg <= opt.agree_deg; };
   // Each frame's own best registration (lowest score on that frame): where that frame alone puts the lidar.
+  // Once a frame was registered on its source re-deskewed with the best extrinsic, only those runs count:
+  // the earlier ones saw the scan bent by the guess's deskew, and their scores are of another cloud.
+  std::set<int> redeskewed_frames;
+  for (const auto& run : r.runs)
+    if (run.redeskewed && run.frame >= 0 && run.frame_score >= 0 && run.result < r.candidates.size())
+      redeskewed_frames.insert(run.frame);
   std::map<int, const RegistratorRun*> frame_best;
   std::set<std::string> agreeing;
   for (const auto& run : r.runs) {
     if (run.result >= r.candidates.size()) continue;
     if (near(distance(r.candidates[run.result], r.T_mapping_calib))) agreeing.insert(run.registrator);
     if (run.frame < 0 || run.frame_score < 0) continue;
+    if (redeskewed_frames.count(run.frame) != 0 && !run.redeskewed) continue;
     auto& best = frame_best[run.frame];
     if (best == nullptr || run.frame_score < best->frame_score) best = &run;
   }

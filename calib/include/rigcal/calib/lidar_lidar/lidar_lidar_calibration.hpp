@@ -47,6 +47,9 @@ struct RegistratorRun {
   std::string status;
   double frame_score = -1.0;  // its own frame's score (m²); −1 = not computed (batched, or out of time)
   double score = -1.0;        // all-frames score (m²); −1 = not computed (not its frame's best)
+  // On the frame's source re-deskewed with the best extrinsic (finalStep), as the final result's last
+  // registrations were: only these are compared with it by the verdict when the frame has any.
+  bool redeskewed = false;
 };
 
 /// What a result is worth, judged against its own evidence (lidar_lidar_verdict.hpp): `ok` only when it
