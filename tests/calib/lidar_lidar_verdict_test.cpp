@@ -167,6 +167,67 @@ TEST(LidarLidarVerdict, AFrameWithoutARedeskewedRunKeepsItsEarlierOnes) {
   EXPECT_NEAR(r.evidence.frame_spread_m, 0.3, 1e-9);
 }
 
+/// Frame `f`'s runs moved by `offset` (mapping frame, which is the lidar's here: the result has no rotation).
+void moveFrame(LidarLidarResult& r, int f, const Eigen::Vector3d& offset) {
+  for (const auto& run : r.runs)
+    if (run.frame == f) r.candidates[run.result].pretranslate(offset);
+}
+
+PoseInformation diagonalInformation(double x, double y, double z) {
+  PoseInformation H = PoseInformation::Identity() * 100.0;
+  H(0, 0) = x;
+  H(1, 1) = y;
+  H(2, 2) = z;
+  return H;
+}
+
+// yard-side's side_left (a VLP-32C rolled 90°): one frame on a straight stretch saw nothing along the lidar's
+// spin axis and its own result drifted 4.1 cm that way, while the other four agreed within 2 mm. The result,
+// refined over all frames, hardly follows a frame where it does not see: weighted by each frame's information,
+// the four frames' agreement decides (ok); counted alike, the one frame's 4 cm made it unverified.
+TEST(LidarLidarVerdict, AFramesScatterAlongADirectionItDoesNotSeeCountsAsLittleAsItPullsTheResult) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0, 1.0});
+  moveFrame(r, 2, {0, 0, 0.04});
+  judgeLidarLidar(r, 4, 10.0);
+  ASSERT_EQ(r.verdict, Verdict::kUnverified) << "counted alike: ± 2 cm";
+  EXPECT_FALSE(r.evidence.frame_uncertainty_weighted);
+  for (int f = 0; f < 4; ++f) r.frame_information[f] = diagonalInformation(100, 100, f == 2 ? 1.0 : 100.0);
+  judgeLidarLidar(r, 4, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.doubt;
+  EXPECT_TRUE(r.evidence.frame_uncertainty_weighted);
+  EXPECT_NEAR(r.evidence.frame_uncertainty_m, 2.0 * 0.04 / 301.0, 1e-9);
+  EXPECT_NEAR(r.evidence.frame_spread_m, 0.04, 1e-9);  // the spread still says where the frame went
+}
+
+// The weights never hide scatter that moves the result: the frame that sees best along z decides z, so its
+// 4 cm count in full; and frames that see alike give the plain standard error (± 2.06 cm as unweighted).
+TEST(LidarLidarVerdict, AFramesScatterAlongWhatItSeesBestCountsInFull) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0, 1.0});
+  moveFrame(r, 2, {0, 0, 0.04});
+  for (int f = 0; f < 4; ++f) r.frame_information[f] = diagonalInformation(100, 100, f == 2 ? 100.0 : 1.0);
+  judgeLidarLidar(r, 4, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_NEAR(r.evidence.frame_uncertainty_m, 2.0 * 100.0 * 0.04 / 103.0, 1e-9);
+
+  auto same = resultWithFrames({1.0, 1.02, 0.98, 1.03});
+  for (int f = 0; f < 4; ++f) same.frame_information[f] = diagonalInformation(50, 50, 50);
+  judgeLidarLidar(same, 4, 10.0);
+  EXPECT_EQ(same.verdict, Verdict::kUnverified);
+  EXPECT_TRUE(same.evidence.frame_uncertainty_weighted);
+  EXPECT_NEAR(same.evidence.frame_uncertainty_m, 2.0 * std::sqrt(0.0017) / 4.0, 1e-9);
+}
+
+// A frame without information (cut before the result was reached): every frame counts alike, as before.
+TEST(LidarLidarVerdict, WithoutEveryFramesInformationFramesCountAlike) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0, 1.0});
+  moveFrame(r, 2, {0, 0, 0.04});
+  for (int f = 0; f < 3; ++f) r.frame_information[f] = diagonalInformation(100, 100, f == 2 ? 1.0 : 100.0);
+  judgeLidarLidar(r, 4, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_FALSE(r.evidence.frame_uncertainty_weighted);
+  EXPECT_NEAR(r.evidence.frame_uncertainty_m, 0.02, 1e-9);
+}
+
 TEST(LidarLidarVerdict, LowInlierRatioIsUnverified) {
   auto r = resultWithFrames({1.0, 1.0, 1.0}, 0.49);
   judgeLidarLidar(r, 3, 10.0);

@@ -81,6 +81,7 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
                    {"frame_spread_deg", e.frame_spread_deg},
                    {"frame_uncertainty_m", e.frame_uncertainty_m},
                    {"frame_uncertainty_deg", e.frame_uncertainty_deg},
+                   {"frame_uncertainty_weighted", e.frame_uncertainty_weighted},
                    {"registrators_agreeing", e.registrators_agreeing},
                    {"inlier_ratio", e.inlier_ratio},
                    {"clock_offset_ms", e.clock_offset_ms}};
