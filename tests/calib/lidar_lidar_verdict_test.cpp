@@ -104,15 +104,21 @@ TEST(LidarLidarVerdict, TheSameScatterOverMoreFramesIsOk) {
 // Rotation counts as translation does: frames 0.1-0.14° apart from a result make ± 0.1° over four frames.
 TEST(LidarLidarVerdict, FramesScatteringInRotationBeyondTheGoalAreUnverified) {
   auto r = resultWithFrames({1.0, 1.0, 1.0, 1.0});
-  r.deadline_reached = true;
   const double yaws[] = {0.1, -0.12, 0.14, -0.1};
   for (auto& run : r.runs) r.candidates[run.result].rotate(Eigen::AngleAxisd(deg2rad(yaws[run.frame]), Eigen::Vector3d::UnitZ()));
   judgeLidarLidar(r, 4, 10.0);
   EXPECT_EQ(r.verdict, Verdict::kUnverified);
   EXPECT_GT(r.evidence.frame_uncertainty_deg, 0.05);
   EXPECT_NE(r.doubt.find("more frames would narrow it"), std::string::npos) << r.doubt;
-  EXPECT_EQ(r.doubt.find("--deadline"), std::string::npos) << r.doubt;  // every frame was registered
+  EXPECT_EQ(r.doubt.find("--deadline"), std::string::npos) << r.doubt;  // the plan ran to its end
   EXPECT_NE(r.doubt.find("deg (two standard errors; the goal is 1.00 cm, 0.05 deg)"), std::string::npos) << r.doubt;
+  // The same frames, every one registered, but the deadline cut the plan before their re-deskewed
+  // confirmations: the deadline is what is missing.
+  r.deadline_reached = true;
+  judgeLidarLidar(r, 4, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_EQ(r.doubt.find("more frames would narrow it"), std::string::npos) << r.doubt;
+  EXPECT_NE(r.doubt.find("--deadline 20"), std::string::npos) << r.doubt;
 }
 
 /// Each frame's confirmation on its source re-deskewed with the result (finalStep), landing at `frame_x`. Its
