@@ -9,14 +9,25 @@
 // With --deadline 60 every calibration lidar must be within the goal. Each preset is simulated once (~60-90 s)
 // and calibrated twice (~2 min each on a loaded machine): RIGCAL_LONG_TESTS=1 (Release) only; 8.1 min for all
 // four in one process at load 7-14 on 2 cores (the other helpers' builds).
-// Measured there (error cm / deg, frames registered / selected, registrations):
-//   default deadline  yard-corners  corner_left 0.44 / 0.018 1/4 5, corner_right 0.41 / 0.033 1/3 5, rear
-//                                   0.97 / 0.093 1/4 5: all unverified (suggested --deadline 30-50)
-//                     yard-side     side_left 0.45 / 0.022 2/5 6, side_right 0.43 / 0.049 4/4 10: both ok
-//   --deadline 60     yard-corners  0.33 / 0.005, 0.11 / 0.006, 0.18 / 0.006 (3-4 frames, 90-100 registrations)
-//                     yard-side     side_left 0.09 / 0.014 5/5 93, side_right 0.57 / 0.031 4/4 397
-// With calibration_frame_ranking: pca instead, yard-side side_left at --deadline 60 was called ok 4.46 cm off
-// (its frames disagreed by 43 cm; the verdict's tolerance is being fixed on main).
+// Measured with `rigcal calibrate` on the presets (error cm / deg, verdict; frames registered / selected), branch
+// s12-mounts against main 849995b, both on the same recordings, offline, nice 15, machine loaded by other builds:
+//   --deadline 60    before  yard-corners  corner_left 0.30 / 0.004 ok, corner_right 0.26 / 0.013 unverified (a
+//                            trajectory clock +18.9 ± 8.9 ms read off a flat profile), rear 0.27 / 0.005 unverified
+//                            (its frames in the turns, deskewed with the guess, 0.1° either side: ± 0.62 cm, 0.068°)
+//                            yard-side     side_left 0.09 / 0.015 unverified (one frame 4.1 cm off along its spin
+//                            axis, which it does not see: ± 2.44 cm), side_right 0.31 / 0.009 unverified (± 1.01 cm)
+//                    after   yard-side (load 6-8): side_left 0.09 / 0.015 ok (± 0.68 cm, each frame's scatter
+//                            weighted by its information), side_right 0.31 / 0.009 ok. yard-corners (load 6-7):
+//                            corner_left 0.30 / 0.004 ok, rear 0.27 / 0.005 ok (± 0.32 cm, 0.007°), corner_right
+//                            0.11 / 0.007 unverified by the same clock reading, which the dip rule then turned into
+//                            ± 13.9 ms (ok in a run at load 10-11, where the 20 s shares of the other two were cut
+//                            before the re-deskew: rear unverified with the --deadline that would do)
+//   default deadline (load 6-10): the plan is cut after 1-2 of 3-5 frames per lidar, before the re-deskew; 0 or 1
+//                    lidar ok per preset, each within the goal (rear 0.66 / 0.029 ok on 2 frames); the others
+//                    unverified with the --deadline that would do, among them side_left 42 cm off on its one frame
+//                    (a straight stretch: blind along its spin axis). Never a wrong ok.
+// The default deadline is not reliably within the goal on a loaded machine (the registrations of one frame take
+// most of a 3-5 s share), so UnderTheDefaultDeadline asserts honesty only.
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -2,6 +2,7 @@
 // 0.3 m / 5° guess, determinism, the deadline, several lidars sharing it, and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -74,6 +75,13 @@ TEST_F(LidarLidarSim, EachCalibrationLidarWithinOneCentimetreAndFiveHundredthsOf
                 d.calibration_sensor.c_str(), dt, dr, r.initial_score.value, r.final_score.value,
                 r.initial_score.inlier_ratio, r.final_score.inlier_ratio, r.seconds, r.runs.size());
     for (const auto& [stage, seconds] : r.stage_seconds) std::printf("  %s %.3f s\n", stage.c_str(), seconds);
+    // Every frame confirmed on its source re-deskewed with the result, which is what the verdict judges by.
+    for (const std::size_t f : r.frames_used) {
+      const bool confirmed = std::any_of(r.runs.begin(), r.runs.end(), [&](const RegistratorRun& run) {
+        return run.frame == int(f) && run.redeskewed && run.frame_score >= 0;
+      });
+      EXPECT_TRUE(confirmed) << d.calibration_sensor << " frame " << f << " has no re-deskewed registration";
+    }
     if (!RIGCAL_SANITIZED) {
       EXPECT_LT(dt, 0.01) << d.calibration_sensor;
       EXPECT_LT(dr, 0.05) << d.calibration_sensor;

@@ -89,6 +89,17 @@ TEST_F(TrajectoryClock, AgreeingClocksAreNotDoubted) {
   EXPECT_EQ(r.doubt.find("clock: "), std::string::npos) << r.doubt;
 }
 
+// yard-corners' corner_right at --deadline 60 (3 frames, the profile within 0.2 % over ±20 ms): dips at +5 and
+// +20 ms. The sharp one alone gave +18.9 ± 8.9 ms, a "late clock" on a lidar 0.11 cm / 0.007° off the truth;
+// the two dips put it at ± 13.9 ms at best (not significant). One clean basin (the rear lidar's) keeps 0.
+TEST(TrajectoryClockProfile, ASecondDipBoundsTheUncertainty) {
+  const std::vector<double> shifts = {-50, -20, -10, -5, 0, 5, 10, 20, 27, 50};
+  const std::vector<double> noisy = {7057.4, 6989.3, 6973.9, 6966.9, 6962.9, 6960.4, 6965.7, 6951.3, 6963.2, 6977.8};
+  EXPECT_DOUBLE_EQ(farthestDip(shifts, noisy, 18.9), 13.9);
+  const std::vector<double> clean = {10835.5, 8997.0, 8023.1, 7745.3, 7620.2, 7691.8, 7991.3, 8895.4, 9500.0, 10794.1};
+  EXPECT_DOUBLE_EQ(farthestDip(shifts, clean, 0.3), 0.3);
+}
+
 TEST(TrajectoryClockParabola, VertexOfUnevenlySpacedSamples) {
   // y = 2 (x − 3)² + 1 sampled at uneven x.
   const auto y = [](double x) { return 2.0 * (x - 3.0) * (x - 3.0) + 1.0; };

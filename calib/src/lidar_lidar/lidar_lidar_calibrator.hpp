@@ -95,7 +95,8 @@ class Calibrator {
   /// Batched ICP over all frames at 0.5 → 0.1 → 0.05 m from `start`.
   void batchedChain(const Pose& start);
 
-  /// Re-deskews every frame with the best extrinsic, then the batched ICP chain from the best; false when
+  /// Re-deskews every frame with the best extrinsic, then the batched ICP chain from the best, then each
+  /// frame's confirmation on its re-deskewed source (what the verdict compares with the result); false when
   /// the deadline cut it. (Upstream, where this is the last step, also runs the chain from the initial guess
   /// here: run() does that after the plan, as a search for another basin like the exhaustive pass.)
   bool finalStep();
@@ -112,7 +113,9 @@ class Calibrator {
   double seconds_per_point_ = 6e-6;
   double last_prepare_seconds_ = 0.0;  // the last frame's source and crop, before its target build
   CalibrationScore initial_score_;
-  std::set<std::tuple<std::size_t, int, std::size_t>> tried_;  // (frame, registrator, start) runs done
+  // (frame, registrator, start, re-deskewed) runs done: a re-deskewed source is another registration problem.
+  std::set<std::tuple<std::size_t, int, std::size_t, bool>> tried_;
+  bool redeskewed_ = false;  // the sources were re-deskewed with the best extrinsic (finalStep)
   Pose best_ = Pose::Identity();
   CalibrationScore best_score_;
 };

@@ -81,6 +81,7 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
                    {"frame_spread_deg", e.frame_spread_deg},
                    {"frame_uncertainty_m", e.frame_uncertainty_m},
                    {"frame_uncertainty_deg", e.frame_uncertainty_deg},
+                   {"frame_uncertainty_weighted", e.frame_uncertainty_weighted},
                    {"registrators_agreeing", e.registrators_agreeing},
                    {"inlier_ratio", e.inlier_ratio},
                    {"clock_offset_ms", e.clock_offset_ms}};
@@ -123,6 +124,7 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
     if (run.max_distance > 0) x["max_distance_m"] = run.max_distance;
     if (run.frame_score >= 0) x["frame_score_m2"] = run.frame_score;
     if (run.score >= 0) x["score_m2"] = run.score;
+    if (run.redeskewed) x["redeskewed"] = true;
     runs.push_back(x);
     json& t = totals[run.registrator];
     if (t.is_null()) t = {{"runs", 0}, {"seconds", 0.0}};

@@ -4,12 +4,14 @@
 // calibration_score.hpp for the score, augmented_target.hpp / calibration_source.hpp for the clouds.
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "rigcal/calib/lidar_lidar/augmented_target.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar/frame_pose_information.hpp"
 #include "rigcal/calib/lidar_lidar/trajectory_time_offset.hpp"
 #include "rigcal/config/parameters.hpp"
 #include "rigcal/core/pose.hpp"
@@ -47,6 +49,9 @@ struct RegistratorRun {
   std::string status;
   double frame_score = -1.0;  // its own frame's score (m²); −1 = not computed (batched, or out of time)
   double score = -1.0;        // all-frames score (m²); −1 = not computed (not its frame's best)
+  // On the frame's source re-deskewed with the best extrinsic (finalStep), as the final result's last
+  // registrations were: only these are compared with it by the verdict when the frame has any.
+  bool redeskewed = false;
 };
 
 /// What a result is worth, judged against its own evidence (lidar_lidar_verdict.hpp): `ok` only when it
@@ -64,10 +69,13 @@ struct LidarLidarEvidence {
   double frame_spread_m = 0.0;       // largest distance of a frame's own best result from the final one
   double frame_spread_deg = 0.0;
   // How far the final result may be off, judged by how its frames scatter about it: two standard errors
-  // (2 · rms / sqrt(n)) over the own best results of the n frames that agree with it (an outlier frame counts
-  // against the result as a disagreeing frame instead); 0 with fewer than two.
+  // over the own best results of the n frames that agree with it (2 · rms / sqrt(n) when they weigh alike;
+  // an outlier frame counts against the result as a disagreeing frame instead); 0 with fewer than two.
   double frame_uncertainty_m = 0.0;
   double frame_uncertainty_deg = 0.0;
+  // Each frame's deviation weighted by its information in each direction (result.frame_information; see
+  // lidar_lidar_verdict.cpp): false when some agreeing frame has none, then every frame counts alike.
+  bool frame_uncertainty_weighted = false;
   std::vector<std::string> registrators_agreeing;  // registrators with a result near the final one
   double inlier_ratio = 0.0;         // of the final score
   double suggested_deadline_s = 0.0; // > 0: the calibration_deadline_s (--deadline) that would confirm it
@@ -97,6 +105,9 @@ struct LidarLidarResult {
   Verdict verdict = Verdict::kFailed;  // kOk needs ok and the evidence; kUnverified: ok but not confirmed
   std::string doubt;                   // one line when verdict is kUnverified: why, and what is missing
   LidarLidarEvidence evidence;
+  // Per dataset frame registered: its information at the result, on the sources the result was refined on
+  // (frame_pose_information.hpp), which weights the frame's scatter in the verdict. Empty: weighted equally.
+  std::map<int, PoseInformation> frame_information;
   TrajectoryClockEstimate trajectory_clock;  // kNotRun unless LidarLidarOptions::trajectory_clock
 };
 

@@ -68,6 +68,10 @@ TrajectoryClockEstimate estimateTrajectoryClockOffset(const std::vector<Trajecto
                                                       const registration::Deadline& deadline,
                                                       const TrajectoryClockOptions& options = {});
 
+/// How far (ms) the farthest local minimum of a cost profile over sorted trial offsets lies from `offset_ms`
+/// (0 with a single dip): a second dip is noise as large as the signal, so the estimate is no better than that.
+double farthestDip(const std::vector<double>& shifts_ms, const std::vector<double>& cost, double offset_ms);
+
 /// The vertex of the parabola through three (x, y) points: (x at the minimum, curvature a of y ≈ a·x² + …).
 /// a ≤ 0: no minimum.
 std::pair<double, double> parabolaVertex(const std::pair<double, double>& p0, const std::pair<double, double>& p1,
