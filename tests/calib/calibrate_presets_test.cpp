@@ -38,7 +38,11 @@ using Clock = std::chrono::steady_clock;
 
 /// sim → calibrate → compare with the issue's bounds; prints the comparison and the stage times. The
 /// lidar-lidar stage keeps to calibration_deadline_s as a whole (all calibration lidars together).
-void calibratePreset(const std::string& label, const std::string& scenario_arg, const TempDir& dir) {
+/// `whole_plan`: every calibration lidar's plan must also finish inside the deadline (every selected frame's
+/// target and ensemble, the batched chain, the re-deskew: `deadline_reached: false`) — a figure of a quiet
+/// machine, which is where the long tests run.
+void calibratePreset(const std::string& label, const std::string& scenario_arg, const TempDir& dir,
+                     bool whole_plan = false) {
   const auto sim = dir / "sim", out = dir / "out";
   double sim_seconds = 0.0;
   ASSERT_NO_FATAL_FAILURE(simulate(scenario_arg, sim, &sim_seconds));
@@ -61,12 +65,22 @@ void calibratePreset(const std::string& label, const std::string& scenario_arg, 
   if (rigcal::test::kWallClockAsserted) {
     EXPECT_LT(report["stage_seconds"]["lidar_lidar"].get<double>(), 1.05 * deadline + 1.0) << report["stage_seconds"];
   }
+  if (whole_plan && rigcal::test::kWallClockAsserted) {
+    for (const auto& l : report["lidars"]) {
+      EXPECT_FALSE(l.value("deadline_reached", true)) << l.value("sensor", "") << ": the deadline cut its plan "
+                                                      << l["stage_seconds"].dump();
+      const auto& e = l.value("evidence", nlohmann::json::object());
+      EXPECT_EQ(e.value("frames_registered", -1), e.value("frames_selected", -2)) << l.value("sensor", "");
+    }
+  }
 }
 
+// The demo: both calibration lidars' whole plans inside the default 10 s (issue 23; 3 of 3 runs on a quiet
+// 2-core machine in session 12: 10/10 and 9/9 frames, 0.08 / 0.12 cm).
 TEST(CalibratePresetsLong, ParkingLot) {
   if (!longTests()) GTEST_SKIP() << "long test: set RIGCAL_LONG_TESTS=1 (Release only)";
   TempDir dir;
-  calibratePreset("parking-lot", "parking-lot", dir);
+  calibratePreset("parking-lot", "parking-lot", dir, /*whole_plan=*/true);
 }
 
 TEST(CalibratePresetsLong, Street) {
