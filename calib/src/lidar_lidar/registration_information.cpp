@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "plane_correspondences.hpp"
 #include "rigcal/registration/point_to_plane_information.hpp"
 
 namespace rigcal::calib {
@@ -41,15 +42,10 @@ RegistrationInformation registrationInformation(const registration::Target& targ
   RegistrationInformation info;
   registration::PointToPlaneInformation H;
   const Eigen::Vector3d t = T.translation();
-  const auto& tn = target.cloud().normals;
-  for (const auto& p : source.points) {
-    const Eigen::Vector4d q = (T * p.head<3>()).homogeneous();
-    registration::Neighbor nb;
-    if (!target.tree().nearest(q, max_distance * max_distance, &nb)) continue;
-    const Eigen::Vector3d n = tn[nb.index].head<3>();
-    if (n.squaredNorm() < 0.5) continue;  // no normal estimated there
-    H.add(q.head<3>() - t, n);
-  }
+  detail::forEachPlaneCorrespondence(target, source, T, max_distance, 1,
+                                     [&](const Eigen::Vector3d&, const Eigen::Vector3d& q, const Eigen::Vector3d& n) {
+                                       H.add(q - t, n);
+                                     });
   info.correspondences = H.correspondences;
   info.translation = decompose(H.translation, double(H.correspondences), weak_share, {"x", "y", "z"});
   info.rotation = decompose(H.rotation, H.lever_sq, weak_share, {"roll", "pitch", "yaw"});
