@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "iterate_cycle.hpp"
+
 namespace rigcal::registration::detail {
 
 namespace {
@@ -28,6 +30,7 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
   out.T = guess;
   out.T_linearized = guess;
   double lambda = params.initial_lambda;
+  IterateCycle cycle;
   for (int it = 0; it < params.max_iterations; ++it) {
     std::optional<LinearSystem> sys = objective.linearize(out.T, deadline);
     if (!sys) {
@@ -46,6 +49,12 @@ SolveOutcome solve(Objective& objective, const Pose& guess, const SolverParams& 
     out.last = *sys;
     if (sys->inliers < params.min_correspondences) {
       out.status = Status::kTooFewCorrespondences;
+      return out;
+    }
+    if (cycle.closes(out.T, sys->cost, params)) {  // the matches take turns: more steps only go round
+      out.T = cycle.best();
+      out.converged = true;
+      out.status = Status::kConverged;
       return out;
     }
     // Marquardt damping on the diagonal, with a floor so directions the data leaves free (a plane's
