@@ -127,4 +127,8 @@ void writeFileAtomically(const std::filesystem::path& path, const std::function<
   file.commit();
 }
 
+void writeFileAtomically(const std::filesystem::path& path, std::string_view text) {
+  writeFileAtomically(path, [&](std::ostream& out) { out.write(text.data(), std::streamsize(text.size())); });
+}
+
 }  // namespace rigcal

@@ -33,12 +33,12 @@ void store(std::uint8_t* p, T v) {
 
 std::int64_t floorMod(std::int64_t a, std::int64_t m) { return ((a % m) + m) % m; }
 
-enum class Vendor : std::uint8_t { kVelodyne, kOuster, kHesai, kRobosense };
+enum class PacketVendor : std::uint8_t { kVelodyne, kOuster, kHesai, kRobosense };
 
 }  // namespace
 
 struct PacketRestamper::Impl {
-  Vendor vendor = Vendor::kVelodyne;
+  PacketVendor vendor = PacketVendor::kVelodyne;
   std::optional<ouster::PacketFormat> ouster_format;
   bool ouster_crc = false;
   const hesai::ModelSpec* hesai_spec = nullptr;
@@ -103,19 +103,19 @@ struct PacketRestamper::Impl {
 PacketRestamper::PacketRestamper(const DecoderConfig& sensor) : impl_(std::make_unique<Impl>()) {
   const auto velodyne_models = velodyneModels();
   if (std::find(velodyne_models.begin(), velodyne_models.end(), sensor.model) != velodyne_models.end()) {
-    impl_->vendor = Vendor::kVelodyne;
+    impl_->vendor = PacketVendor::kVelodyne;
   } else if (const hesai::ModelSpec* spec = hesai::findModel(sensor.model)) {
-    impl_->vendor = Vendor::kHesai;
+    impl_->vendor = PacketVendor::kHesai;
     impl_->hesai_spec = spec;
   } else if (const auto robosense_models = robosenseModels();
              std::find(robosense_models.begin(), robosense_models.end(), sensor.model) != robosense_models.end()) {
-    impl_->vendor = Vendor::kRobosense;
+    impl_->vendor = PacketVendor::kRobosense;
   } else if (const auto ouster_models = ousterModels();
              std::find(ouster_models.begin(), ouster_models.end(), sensor.model) != ouster_models.end()) {
     if (sensor.metadata.empty())
       throw std::runtime_error("Ouster " + sensor.model + ": restamping needs its metadata (sensor_info JSON)");
     const ouster::Metadata md = ouster::parseMetadataFile(sensor.metadata);
-    impl_->vendor = Vendor::kOuster;
+    impl_->vendor = PacketVendor::kOuster;
     impl_->ouster_format.emplace(md.profile, md.pixels_per_column, md.columns_per_packet);
     impl_->ouster_crc = md.crcFooter();
   } else {
@@ -129,10 +129,10 @@ PacketRestamper& PacketRestamper::operator=(PacketRestamper&&) noexcept = defaul
 
 bool PacketRestamper::restamp(std::span<std::uint8_t> payload, std::int64_t shift_us) const {
   switch (impl_->vendor) {
-    case Vendor::kVelodyne: return impl_->velodyne(payload, shift_us);
-    case Vendor::kOuster: return impl_->ouster(payload, shift_us);
-    case Vendor::kHesai: return impl_->hesai(payload, shift_us);
-    case Vendor::kRobosense: return Impl::robosense(payload, shift_us);
+    case PacketVendor::kVelodyne: return impl_->velodyne(payload, shift_us);
+    case PacketVendor::kOuster: return impl_->ouster(payload, shift_us);
+    case PacketVendor::kHesai: return impl_->hesai(payload, shift_us);
+    case PacketVendor::kRobosense: return Impl::robosense(payload, shift_us);
   }
   return false;
 }

@@ -12,7 +12,7 @@
 namespace rigcal::registration {
 
 namespace {
-constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
+constexpr std::uint32_t kNoCell = std::numeric_limits<std::uint32_t>::max();
 
 struct Accumulator {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // first point: sums relative to it stay precise
@@ -71,11 +71,11 @@ NdtGrid::NdtGrid(const PointCloud& cloud, const NdtGridOptions& options) : optio
 
   std::size_t capacity = 16;
   while (capacity < 2 * cells_.size()) capacity *= 2;
-  table_.assign(capacity, Slot{0, 0, 0, kEmpty});
+  table_.assign(capacity, Slot{0, 0, 0, kNoCell});
   mask_ = capacity - 1;
   for (std::size_t i = 0; i < cells_.size(); ++i) {
     std::size_t slot = detail::hashVoxel(coords[i]) & mask_;
-    while (table_[slot].cell != kEmpty) slot = (slot + 1) & mask_;
+    while (table_[slot].cell != kNoCell) slot = (slot + 1) & mask_;
     table_[slot] = {coords[i].x, coords[i].y, coords[i].z, static_cast<std::uint32_t>(i)};
   }
 }
@@ -84,7 +84,7 @@ const NdtCell* NdtGrid::find(std::int64_t x, std::int64_t y, std::int64_t z) con
   std::size_t slot = detail::hashVoxel({x, y, z}) & mask_;
   for (;;) {
     const Slot& s = table_[slot];
-    if (s.cell == kEmpty) return nullptr;
+    if (s.cell == kNoCell) return nullptr;
     if (s.x == x && s.y == y && s.z == z) return &cells_[s.cell];
     slot = (slot + 1) & mask_;
   }

@@ -28,10 +28,6 @@ Pose perturb(const Pose& T, double translation, double angle, Rng& rng) {
   return out;
 }
 
-void writeFile(const std::filesystem::path& file, const std::string& text) {
-  writeFileAtomically(file, [&](std::ostream& out) { out << text; });
-}
-
 std::string velodyneYaml(const LidarModel& m) {
   std::ostringstream y;
   y << "# " << m.name << " laser angles used by rigcal sim (radians; rot_correction = −azimuth offset).\n";
@@ -166,7 +162,7 @@ std::vector<std::filesystem::path> writeRigFiles(const Simulation& sim, const st
     const LidarModel& m = sim.model(i);
     const auto [name, text] = vendorFile(s, m);
     if (!name.empty()) {
-      writeFile(dir / name, text);
+      writeFileAtomically(dir / name, text);
       written.push_back(dir / name);
     }
     y << "  - name: " << s.name << "\n";
@@ -190,7 +186,7 @@ std::vector<std::filesystem::path> writeRigFiles(const Simulation& sim, const st
     y << "parameters:\n";
     for (const auto& [key, value] : sc.rig_parameters) y << "  " << key << ": " << value << "\n";
   }
-  writeFile(dir / "rig.yaml", y.str());
+  writeFileAtomically(dir / "rig.yaml", y.str());
   written.push_back(dir / "rig.yaml");
   return written;
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fast_floor.hpp"
+
 namespace rigcal::sim {
 namespace {
 
@@ -14,11 +16,7 @@ void grow(Rect2& acc, const Rect2& r) {
   acc.y1 = std::max(acc.y1, r.y1);
 }
 
-// floor() for values well inside int range; std::floor is a libm call without SSE4.1.
-inline int fastFloor(double v) {
-  const int i = int(v);
-  return i - (v < double(i));
-}
+using detail::fastFloor;
 
 bool insidePatch(const GroundPatch& p, double x, double y) {
   const double px = x - p.cx, py = y - p.cy;

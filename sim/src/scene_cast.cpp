@@ -7,14 +7,12 @@
 #include <vector>
 
 #include "rigcal/sim/scene.hpp"
+#include "fast_floor.hpp"
 
 namespace rigcal::sim {
 namespace {
 
-inline int fastFloor(double v) {  // std::floor is a libm call without SSE4.1
-  const int i = int(v);
-  return i - (v < double(i));
-}
+using detail::fastFloor;
 
 /// A 2D DDA over square cells of `size` anchored at (x0, y0), restricted to an index window.
 struct Walk {

@@ -24,10 +24,6 @@ std::string poseFlow(const Pose& T) {
          ", qx: " + fixed(qp.x(), 12) + ", qy: " + fixed(qp.y(), 12) + ", qz: " + fixed(qp.z(), 12) + "}";
 }
 
-void writeFile(const std::filesystem::path& file, const std::string& text) {
-  writeFileAtomically(file, [&](std::ostream& out) { out << text; });
-}
-
 }  // namespace
 
 void writeTruthYaml(const Simulation& sim, const std::filesystem::path& file) {
@@ -89,7 +85,7 @@ void writeTruthYaml(const Simulation& sim, const std::filesystem::path& file) {
       y << "      time_offset_to_add_to_lidar_s: " << fixed(toSeconds(p.clock_offset_ns - s.clock_offset_ns), 9) << "\n";
     }
   }
-  writeFile(file, y.str());
+  writeFileAtomically(file, y.str());
 }
 
 std::vector<PoseSample> poseSamples(const Simulation& sim) {
@@ -137,7 +133,7 @@ void writePosesCsv(const Simulation& sim, const std::filesystem::path& file) {
         << fixed(x.z(), 6) << ", " << fixed(q.w(), 9) << ", " << fixed(q.x(), 9) << ", " << fixed(q.y(), 9) << ", "
         << fixed(q.z(), 9) << "\n";
   }
-  writeFile(file, out.str());
+  writeFileAtomically(file, out.str());
 }
 
 }  // namespace rigcal::sim

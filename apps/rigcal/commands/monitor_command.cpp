@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <csignal>
 #include <cstdio>
 #include <ctime>
 #include <iomanip>
@@ -15,6 +14,7 @@
 
 #include "../commands.hpp"
 #include "../exit_codes.hpp"
+#include "../stop_signals.hpp"
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/shm/liveness.hpp"
 #include "rigcal/shm/ring_inspect.hpp"
@@ -24,9 +24,6 @@
 namespace rigcal::app {
 
 namespace {
-
-volatile std::sig_atomic_t g_stop = 0;
-void onSignal(int) { g_stop = 1; }
 
 struct MonitorOptions {
   std::string config;
@@ -109,15 +106,14 @@ void runMonitor(const MonitorOptions& o) {
   }
   const std::string prefix = shm::defaultNamePrefix();
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  const StopSignals stop_signals;
   const auto interval_ns = static_cast<std::int64_t>(o.interval * 1e9);
   std::map<std::string, shm::RingInfo> before;
   for (const auto& n : ringNames(sensors, prefix)) before[n] = shm::inspectRing(n);
-  while (!g_stop) {
+  while (!StopSignals::requested()) {
     timespec ts{static_cast<time_t>(interval_ns / 1'000'000'000), static_cast<long>(interval_ns % 1'000'000'000)};
     ::nanosleep(&ts, nullptr);  // a signal cuts it short
-    if (g_stop && !o.once) break;
+    if (StopSignals::requested() && !o.once) break;
     const std::vector<std::string> names = ringNames(sensors, prefix);
     std::map<std::string, shm::RingInfo> now;
     for (const auto& n : names) now[n] = shm::inspectRing(n);

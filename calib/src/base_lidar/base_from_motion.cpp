@@ -28,7 +28,8 @@ struct Chord {
   bool reversing = false;
 };
 
-double median(std::vector<double> v) {
+// The upper of the two middle values for an even count (robust scale: no averaging needed).
+double upperMedian(std::vector<double> v) {
   if (v.empty()) return 0.0;
   const std::size_t mid = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(mid), v.end());
@@ -139,7 +140,7 @@ Fit robustFit(const std::vector<const Chord*>& chords, double yaw0, double x0, b
     for (std::size_t k = 0; k < n; ++k)
       if (w[k] > 0) inlier_abs.push_back(std::abs(r[k]));
     // A floor of 0.1 mm: below the mapper's noise, rejecting would only cut the exact model's rounding.
-    sigma = std::max(1.4826 * median(inlier_abs), 1e-4);
+    sigma = std::max(1.4826 * upperMedian(inlier_abs), 1e-4);
     std::vector<double> next(n);
     for (std::size_t k = 0; k < n; ++k) {
       const double z = std::abs(r[k]) / sigma;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <stdexcept>
 
@@ -16,7 +17,6 @@ constexpr std::int64_t kLateToleranceUnits = 500;       // a backward step up to
 constexpr std::uint32_t kMaxCountedGap = 1u << 20;      // larger sequence jumps: a sensor restart
 constexpr std::uint32_t kMaxReorder = 4096;             // sequence steps back further: a restart
 constexpr double kDualReturnThresholdM = 0.1;
-constexpr double kPi = 3.14159265358979323846;
 
 std::int64_t floorDiv(std::int64_t a, std::int64_t b) {
   const std::int64_t q = a / b;
@@ -28,7 +28,7 @@ struct AzimuthTable {
   std::vector<float> cos, sin;
   AzimuthTable() : cos(kUnitsPerTurn), sin(kUnitsPerTurn) {
     for (std::int64_t a = 0; a < kUnitsPerTurn; ++a) {
-      const double rad = static_cast<double>(a) * 0.01 * kPi / 180.0;
+      const double rad = static_cast<double>(a) * 0.01 * std::numbers::pi / 180.0;
       cos[a] = static_cast<float>(std::cos(rad));
       sin[a] = static_cast<float>(std::sin(rad));
     }
@@ -76,8 +76,8 @@ HesaiDecoder::HesaiDecoder(const hesai::ModelSpec& spec, const hesai::Calibratio
   for (std::uint16_t c : order_) {
     // Bucket b holds corrected azimuths in (b, b + 1] × 0.01°.
     shift_.push_back(floorDiv(offset_udeg[c] - 1, kMicroDegPerUnit));
-    const double elevation = cal.elevation_deg[c] * kPi / 180.0;
-    const double offset = cal.azimuth_offset_deg[c] * kPi / 180.0;
+    const double elevation = cal.elevation_deg[c] * std::numbers::pi / 180.0;
+    const double offset = cal.azimuth_offset_deg[c] * std::numbers::pi / 180.0;
     xy_cos_.push_back(static_cast<float>(std::cos(elevation) * std::cos(offset)));
     xy_sin_.push_back(static_cast<float>(std::cos(elevation) * std::sin(offset)));
     z_sin_.push_back(static_cast<float>(std::sin(elevation)));

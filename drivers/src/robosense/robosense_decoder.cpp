@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace rigcal::drivers {
@@ -9,11 +10,10 @@ namespace {
 
 using namespace robosense;
 
-constexpr std::int32_t kUnitsPerTurn = 36000;  // 0.01°
+constexpr std::int32_t kAzimuthUnitsPerTurn = 36000;  // 0.01°
 constexpr float kBlockUs = 55.56f;             // one block's firing period
 constexpr std::int64_t kBlockNs = 55560;
 constexpr float kLensOffsetM = 0.03498f;       // optical centre to rotation axis (rs_driver's RX)
-constexpr double kPi = 3.14159265358979323846;
 // Firing offset of each of the 32 channel slots from the block start (µs), from nebula's Helios-16P decoder.
 constexpr float kFiringUs[kChannelsPerBlock] = {
     0.00f,  3.15f,  6.30f,  9.45f,  13.26f, 17.08f, 20.56f, 23.71f, 26.53f, 27.77f, 31.49f,
@@ -22,14 +22,14 @@ constexpr float kFiringUs[kChannelsPerBlock] = {
 
 struct Trig {
   std::vector<float> cos, sin;
-  Trig() : cos(kUnitsPerTurn), sin(kUnitsPerTurn) {
-    for (int a = 0; a < kUnitsPerTurn; ++a) {
-      const double rad = a * 0.01 * kPi / 180.0;
+  Trig() : cos(kAzimuthUnitsPerTurn), sin(kAzimuthUnitsPerTurn) {
+    for (int a = 0; a < kAzimuthUnitsPerTurn; ++a) {
+      const double rad = a * 0.01 * std::numbers::pi / 180.0;
       cos[std::size_t(a)] = float(std::cos(rad));
       sin[std::size_t(a)] = float(std::sin(rad));
     }
   }
-  static std::size_t index(std::int32_t a) { return std::size_t(((a % kUnitsPerTurn) + kUnitsPerTurn) % kUnitsPerTurn); }
+  static std::size_t index(std::int32_t a) { return std::size_t(((a % kAzimuthUnitsPerTurn) + kAzimuthUnitsPerTurn) % kAzimuthUnitsPerTurn); }
 };
 const Trig& trig() {
   static const Trig t;
@@ -61,10 +61,10 @@ void RobosenseDecoder::applyDeviceInfo(const DeviceInfo& info) {
   int rps = info.rpm / 60;  // whole turns per second, as the vendors' decoders
   if (rps == 0) rps = 10;
   scan_rate_hz_ = rps;
-  block_az_diff_ = std::int32_t(std::lround(double(kUnitsPerTurn) * rps * double(kBlockUs / 1e6f)));
+  block_az_diff_ = std::int32_t(std::lround(double(kAzimuthUnitsPerTurn) * rps * double(kBlockUs / 1e6f)));
   const int fov_range = info.fov_start < info.fov_end ? info.fov_end - info.fov_start
-                                                      : info.fov_end + kUnitsPerTurn - info.fov_start;
-  fov_blind_ns_ = std::llround(double(kUnitsPerTurn - fov_range) / (double(kUnitsPerTurn) * rps) * 1e9);
+                                                      : info.fov_end + kAzimuthUnitsPerTurn - info.fov_start;
+  fov_blind_ns_ = std::llround(double(kAzimuthUnitsPerTurn - fov_range) / (double(kAzimuthUnitsPerTurn) * rps) * 1e9);
   for (int c = 0; c < kChannelsPerBlock; ++c) {
     // Single return: 32 slots are two firings of the 16 lasers; dual: both returns of one firing.
     const float us = dual_ ? kFiringUs[c % kLasers] : kFiringUs[c];
@@ -72,7 +72,7 @@ void RobosenseDecoder::applyDeviceInfo(const DeviceInfo& info) {
     chan_ns_[std::size_t(c)] = std::int32_t(std::lround(double(us) * 1000.0));
   }
   for (int l = 0; l < kLasers; ++l) {
-    const double v = info.vertical[std::size_t(l)] * 0.01 * kPi / 180.0;
+    const double v = info.vertical[std::size_t(l)] * 0.01 * std::numbers::pi / 180.0;
     cos_vert_[std::size_t(l)] = float(std::cos(v));
     sin_vert_[std::size_t(l)] = float(std::sin(v));
     horiz_[std::size_t(l)] = info.horizontal[std::size_t(l)];
@@ -109,7 +109,7 @@ TimeNs RobosenseDecoder::decodeMsop(const MsopView& view, TimeNs receive_ns, Dec
     std::int32_t diff = block_az_diff_;
     std::int64_t step = kBlockNs;
     if (b + group < kBlocks) {
-      diff = (std::int32_t(view.azimuth(b + group)) - view.azimuth(b) + kUnitsPerTurn) % kUnitsPerTurn;
+      diff = (std::int32_t(view.azimuth(b + group)) - view.azimuth(b) + kAzimuthUnitsPerTurn) % kAzimuthUnitsPerTurn;
       if (diff > 100) {  // across the blind part of a limited FOV
         diff = block_az_diff_;
         step = fov_blind_ns_;

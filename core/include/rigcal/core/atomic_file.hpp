@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <ostream>
+#include <string_view>
 
 namespace rigcal {
 
@@ -37,5 +38,7 @@ class AtomicFile {
 
 /// Writes `path` atomically with whatever `fill` puts into the stream.
 void writeFileAtomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& fill);
+/// Writes `text` to `path` atomically.
+void writeFileAtomically(const std::filesystem::path& path, std::string_view text);
 
 }  // namespace rigcal
