@@ -34,16 +34,19 @@ test-release: build
 	cd $(BUILD) && $(CTEST)
 
 # clang for both sanitizer builds: it compiles this code base's instrumented objects in about half of
-# GCC's CPU time (calibrate_command.cpp with ASan+UBSan: 17.8 s against 32.0 s).
+# GCC's CPU time (calibrate_command.cpp with ASan+UBSan: 17.8 s against 32.0 s). Both build the libraries
+# and the executable as unity batches (RIGCAL_UNITY_BUILD): from scratch, 2.3x less CPU for them.
 test-asan: deps
-	CXX=clang++ cmake -S . -B $(ASAN) $(GENERATOR) -DCMAKE_BUILD_TYPE=Debug -DRIGCAL_SANITIZE=address
+	CXX=clang++ cmake -S . -B $(ASAN) $(GENERATOR) -DCMAKE_BUILD_TYPE=Debug -DRIGCAL_SANITIZE=address \
+	  -DRIGCAL_UNITY_BUILD=ON
 	cmake --build $(ASAN) -j $(JOBS)
 	cd $(ASAN) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 $(CTEST)
 
 # clang: GCC's TSan refuses the standalone fences moodycamel's queue relies on. Only the suites that run
 # threads or processes against each other (RIGCAL_CONCURRENT_TESTS in tests/CMakeLists.txt) are built here.
 test-tsan: deps
-	CXX=clang++ cmake -S . -B $(TSAN) $(GENERATOR) -DCMAKE_BUILD_TYPE=Debug -DRIGCAL_SANITIZE=thread
+	CXX=clang++ cmake -S . -B $(TSAN) $(GENERATOR) -DCMAKE_BUILD_TYPE=Debug -DRIGCAL_SANITIZE=thread \
+	  -DRIGCAL_UNITY_BUILD=ON
 	cmake --build $(TSAN) -j $(JOBS)
 	cd $(TSAN) && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tests/tsan.supp" $(CTEST)
 
