@@ -11,108 +11,21 @@
 namespace rigcal::calib::detail {
 
 void Calibrator::run() {
-  const auto t0 = Clock::now();
   out_.candidates = {data_.T_mapping_calib_guess};
   best_ = data_.T_mapping_calib_guess;
-  // The most informative frame first, alone: its ensemble gives the big correction early.
-  std::size_t next = 0;
-  bool out_of_time = false;
-  while (frames_.empty() && next < data_.frames.size() && !out_of_time)
-    out_of_time = stopped() || buildFrame(next++) == FrameBuild::kOutOfTime;
-  double target_seconds = since(t0);
-  if (frames_.empty()) {
-    out_.deadline_reached = out_of_time;
-    out_.failure = out_of_time ? "deadline reached before any calibration frame's target was built"
-                               : "no calibration frame has a usable source and target";
-    out_.stage_seconds.emplace_back("targets", target_seconds);
-    return;
-  }
-  rescore();
-  out_.initial_score = initial_score_;
-  double ensemble_seconds = 0.0, batched_seconds = 0.0;
-  auto t = Clock::now();
-  frameEnsemble(0, /*exhaustive=*/false);
-  ensemble_seconds += since(t);
-  // Then every other frame, scored together from now on.
-  t = Clock::now();
+  std::size_t next = 0;  // the next dataset frame to build
+  if (!firstFrame(next)) return;
   const std::size_t first_frames = frames_.size();
-  bool targets_cut = false;
-  while (next < data_.frames.size() && !targets_cut) {
-    // After a frame's target, time for what makes one estimate of the frames: the grown set's rescore (else
-    // the new frames are dropped) and the batched chain. Without that reserve a loaded machine spent the
-    // whole share on targets and never ran the batched ICP (parking lot at load 7: front_right 1.0-1.3 cm
-    // off). The source and crop must fit as long as the last ones took; whether the target build fits is
-    // judged on the cropped cloud (buildFrame).
-    const double grown_next = double(frames_.size() + 1) / double(first_frames);
-    const double reserve = 2.5 * grown_next * score_seconds_ + batchedChainEstimate(frames_.size() + 1);
-    const std::size_t built = frames_.size();
-    targets_cut = !fits(deadline_, 1.2 * last_prepare_seconds_ + reserve) ||
-                  buildFrame(next++, reserve) == FrameBuild::kOutOfTime;
-    if (targets_cut) break;
-    target_seconds += since(t);
-    // Its own view of the best at once (one ICP), before the next target: if the deadline cuts the
-    // targets, the frames built so far still count as evidence for the verdict (lidar_lidar_verdict.hpp).
-    t = Clock::now();
-    if (frames_.size() > built && !stopped()) confirmOnFrame(frames_.size() - 1);
-    ensemble_seconds += since(t);
-    t = Clock::now();
-  }
-  target_seconds += since(t);
-  // A next target that did not fit ends the targets, not the plan: the frames built so far still get the
-  // rescore, the batched chain and their ensembles in the time left (it had skipped all of them: under load
-  // the batched ICP never ran).
-  double final_seconds = 0.0;
-  // The plan's steps after the targets, the most valuable first; false when one ran out of time (the ones
-  // after it are skipped).
-  const auto steps = [&] {
-    // Rescoring the guess and the best over the grown set costs two scores of the new size.
-    const double grown = double(frames_.size()) / double(first_frames);
-    if (frames_.size() > first_frames && !fits(deadline_, 2.5 * grown * score_seconds_)) {
-      // No time to score the grown set: keep the frames the scores were computed on.
-      frames_.resize(first_frames);
-      out_.frames_used.resize(first_frames);
-      return false;
-    }
-    if (frames_.size() > first_frames) rescore();
-    t = Clock::now();
-    if (!stopped()) batchedChain(best_);
-    batched_seconds += since(t);
-    if (stopped()) return false;
-    // The re-deskew before the other frames' ensembles: it is worth more, and last in the plan it was what
-    // a loaded machine never reached (parking lot at load 8, every frame built: front_right 0.63 cm off
-    // without it, 0.01 cm with it on a quiet machine). Those ensembles then run on the re-deskewed sources.
-    t = Clock::now();
-    const bool redeskewed = finalStep();
-    final_seconds = since(t);
-    if (!redeskewed) return false;
-    t = Clock::now();
-    const Pose before_ensembles = best_;
-    for (std::size_t k = 1; k < frames_.size() && !stopped(); ++k) frameEnsemble(k, false);
-    if (!samePose(before_ensembles, best_) && !stopped()) batchedChain(best_);
-    ensemble_seconds += since(t);
-    return !stopped();
-  };
-  const bool finished = steps();
-  const bool plan_cut = targets_cut || !finished;
-  // Here the plan is done: every frame through its ensemble, the batched chain, the re-deskew and the chain
-  // again from the best. Whatever time is left goes to the searches for another basin: upstream's batched
-  // chain from the initial guess (on the street's VLS-128 map it ran its 200 iterations at 0.5 m without
-  // converging: 0.6 s of a 3.3 s share), then its exhaustive ensemble (every registrator from every
-  // candidate); a better result gets the final batched refinement too. The deadline ending them does not
-  // make the result "the best so far of a cut plan".
-  t = Clock::now();
-  const Pose before_search = best_;
-  if (finished && !stopped()) batchedChain(data_.T_mapping_calib_guess);
-  for (std::size_t k = 0; k < frames_.size() && finished && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
-  if (finished && !samePose(before_search, best_) && !stopped()) batchedChain(best_);
-  ensemble_seconds += since(t);
+  const bool targets_cut = laterTargets(next, first_frames);
+  const bool finished = restOfPlan(first_frames);
+  if (finished) searchForAnotherBasin();
   // A run cancelled from outside (the user stopping it) is cut wherever it was.
   const bool cancelled = deadline_.token() != nullptr && deadline_.token()->cancelled();
-  out_.deadline_reached = plan_cut || cancelled;
-  out_.stage_seconds = {{"targets", target_seconds},
-                        {"ensemble", ensemble_seconds},
-                        {"batched", batched_seconds},
-                        {"redeskew_final", final_seconds}};
+  out_.deadline_reached = targets_cut || !finished || cancelled;
+  out_.stage_seconds = {{"targets", seconds_.targets},
+                        {"ensemble", seconds_.ensemble},
+                        {"batched", seconds_.batched},
+                        {"redeskew_final", seconds_.redeskew_final}};
 
   out_.T_mapping_calib = best_;
   out_.final_score = best_score_;
@@ -127,6 +40,102 @@ void Calibrator::run() {
         << out_.initial_score.inlier_ratio << ")" << (out_.deadline_reached ? " before the deadline" : "");
     out_.failure = msg.str();
   }
+}
+
+bool Calibrator::firstFrame(std::size_t& next) {
+  // The most informative frame first, alone: its ensemble gives the big correction early.
+  auto t = Clock::now();
+  bool out_of_time = false;
+  while (frames_.empty() && next < data_.frames.size() && !out_of_time)
+    out_of_time = stopped() || buildFrame(next++) == FrameBuild::kOutOfTime;
+  seconds_.targets += since(t);
+  if (frames_.empty()) {
+    out_.deadline_reached = out_of_time;
+    out_.failure = out_of_time ? "deadline reached before any calibration frame's target was built"
+                               : "no calibration frame has a usable source and target";
+    out_.stage_seconds.emplace_back("targets", seconds_.targets);
+    return false;
+  }
+  rescore();
+  t = Clock::now();
+  frameEnsemble(0, /*exhaustive=*/false);
+  seconds_.ensemble += since(t);
+  return true;
+}
+
+bool Calibrator::laterTargets(std::size_t& next, std::size_t first_frames) {
+  // Every other frame, scored together from now on.
+  auto t = Clock::now();
+  bool targets_cut = false;
+  while (next < data_.frames.size() && !targets_cut) {
+    // After a frame's target, time for what makes one estimate of the frames: the grown set's rescore (else
+    // the new frames are dropped) and the batched chain. Without that reserve a loaded machine spent the
+    // whole share on targets and never ran the batched ICP (parking lot at load 7: front_right 1.0-1.3 cm
+    // off). The source and crop must fit as long as the last ones took; whether the target build fits is
+    // judged on the cropped cloud (buildFrame).
+    const double grown_next = double(frames_.size() + 1) / double(first_frames);
+    const double reserve = 2.5 * grown_next * score_seconds_ + batchedChainEstimate(frames_.size() + 1);
+    const std::size_t built = frames_.size();
+    targets_cut = !fits(deadline_, 1.2 * last_prepare_seconds_ + reserve) ||
+                  buildFrame(next++, reserve) == FrameBuild::kOutOfTime;
+    if (targets_cut) break;
+    seconds_.targets += since(t);
+    // Its own view of the best at once (one ICP), before the next target: if the deadline cuts the
+    // targets, the frames built so far still count as evidence for the verdict (lidar_lidar_verdict.hpp).
+    t = Clock::now();
+    if (frames_.size() > built && !stopped()) confirmOnFrame(frames_.size() - 1);
+    seconds_.ensemble += since(t);
+    t = Clock::now();
+  }
+  seconds_.targets += since(t);
+  return targets_cut;
+}
+
+bool Calibrator::restOfPlan(std::size_t first_frames) {
+  // A next target that did not fit ends the targets, not the plan: the frames built so far still get the
+  // rescore, the batched chain and their ensembles in the time left (it had skipped all of them: under load
+  // the batched ICP never ran).
+  // Rescoring the guess and the best over the grown set costs two scores of the new size.
+  const double grown = double(frames_.size()) / double(first_frames);
+  if (frames_.size() > first_frames && !fits(deadline_, 2.5 * grown * score_seconds_)) {
+    // No time to score the grown set: keep the frames the scores were computed on.
+    frames_.resize(first_frames);
+    out_.frames_used.resize(first_frames);
+    return false;
+  }
+  if (frames_.size() > first_frames) rescore();
+  auto t = Clock::now();
+  if (!stopped()) batchedChain(best_);
+  seconds_.batched += since(t);
+  if (stopped()) return false;
+  // The re-deskew before the other frames' ensembles: it is worth more, and last in the plan it was what
+  // a loaded machine never reached (parking lot at load 8, every frame built: front_right 0.63 cm off
+  // without it, 0.01 cm with it on a quiet machine). Those ensembles then run on the re-deskewed sources.
+  t = Clock::now();
+  const bool redeskewed = finalStep();
+  seconds_.redeskew_final = since(t);
+  if (!redeskewed) return false;
+  t = Clock::now();
+  const Pose before_ensembles = best_;
+  for (std::size_t k = 1; k < frames_.size() && !stopped(); ++k) frameEnsemble(k, false);
+  if (!samePose(before_ensembles, best_) && !stopped()) batchedChain(best_);
+  seconds_.ensemble += since(t);
+  return !stopped();
+}
+
+void Calibrator::searchForAnotherBasin() {
+  // Here the plan is done: every frame through its ensemble, the batched chain, the re-deskew and the chain
+  // again from the best. Whatever time is left goes to the searches for another basin: upstream's batched
+  // chain from the initial guess (on the street's VLS-128 map it ran its 200 iterations at 0.5 m without
+  // converging: 0.6 s of a 3.3 s share), then its exhaustive ensemble (every registrator from every
+  // candidate); a better result gets the final batched refinement too. The deadline ending them does not
+  // make the result "the best so far of a cut plan".
+  const auto t = Clock::now();
+  const Pose before_search = best_;
+  if (!stopped()) batchedChain(data_.T_mapping_calib_guess);
+  for (std::size_t k = 0; k < frames_.size() && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
+  if (!samePose(before_search, best_) && !stopped()) batchedChain(best_);
+  seconds_.ensemble += since(t);
 }
 
 double Calibrator::batchedChainEstimate(std::size_t frames) const {

@@ -52,6 +52,19 @@ class Calibrator {
   [[nodiscard]] const std::vector<Frame>& frames() const { return frames_; }
 
  private:
+  // The plan, in run()'s order. Each phase stops when the deadline passes.
+  /// The first dataset frame that builds, and its ensemble; `next` moves past the frames tried. False (with
+  /// out_.failure) when no frame could be built.
+  bool firstFrame(std::size_t& next);
+  /// The other frames' targets, each confirmed by one ICP, while each leaves time for the rescore and the
+  /// batched chain; true when the deadline cut them.
+  bool laterTargets(std::size_t& next, std::size_t first_frames);
+  /// The grown set's rescore, the batched chain, the re-deskew, then the other frames' ensembles; true when
+  /// all of it ran.
+  bool restOfPlan(std::size_t first_frames);
+  /// After the plan, until the deadline: the chain from the initial guess and the exhaustive ensembles.
+  void searchForAnotherBasin();
+
   /// The deadline passed (or the run was cancelled): every step stops. Whether that cut the plan is run()'s
   /// call (out_.deadline_reached): the exhaustive pass at the end only fills the time left.
   [[nodiscard]] bool stopped() const;
@@ -107,6 +120,9 @@ class Calibrator {
   const LidarLidarOptions& opt_;
   LidarLidarResult& out_;
   std::vector<Frame> frames_;
+  struct StageSeconds {
+    double targets = 0.0, ensemble = 0.0, batched = 0.0, redeskew_final = 0.0;
+  } seconds_;  // out_.stage_seconds
   std::vector<SourceTarget> score_pairs_;
   double score_seconds_ = 0.0;
   // Target build cost per point; until measured, a pessimistic guess (measured 2–7 µs on a loaded 2-core box).
