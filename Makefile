@@ -5,7 +5,8 @@ ASAN      ?= build-asan
 TSAN      ?= build-tsan
 GENERATOR := $(shell command -v ninja >/dev/null 2>&1 && echo "-G Ninja")
 # ccache (when installed) keys objects on paths relative to the checkout, so a fresh clone elsewhere on the
-# same machine reuses what an earlier build compiled.
+# same machine reuses what an earlier build compiled (except unity batches, which name their sources by
+# absolute path: those are reused by a clone at the same place).
 export CCACHE_BASEDIR ?= $(CURDIR)
 export CCACHE_MAXSIZE ?= 20G
 CTEST     := ctest --output-on-failure --timeout 600 -j $(JOBS)
@@ -15,8 +16,12 @@ CTEST     := ctest --output-on-failure --timeout 600 -j $(JOBS)
 deps:
 	@scripts/install-deps
 
+# A build folder `make test` creates compiles each library in unity batches (RIGCAL_UNITY_BUILD, as the
+# sanitizer builds do): it builds everything from scratch. One that `make build` or `make demo` creates keeps
+# one object per source, so that an edit recompiles only its file.
+RELEASE_UNITY ?= OFF
 $(BUILD)/build.ninja $(BUILD)/Makefile:
-	cmake -S . -B $(BUILD) $(GENERATOR) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD) $(GENERATOR) -DCMAKE_BUILD_TYPE=Release -DRIGCAL_UNITY_BUILD=$(RELEASE_UNITY)
 
 build: deps $(BUILD)/$(if $(GENERATOR),build.ninja,Makefile)
 	cmake --build $(BUILD) -j $(JOBS)
@@ -29,6 +34,7 @@ build-rigcal: deps $(BUILD)/$(if $(GENERATOR),build.ninja,Makefile)
 # a bounded time (clang, ASan+UBSan).
 FUZZ_CI_SECONDS ?= 10
 test: deps test-release test-asan test-tsan test-fuzz
+test: RELEASE_UNITY = ON
 
 test-release: build
 	cd $(BUILD) && $(CTEST)
