@@ -38,7 +38,7 @@ int registrationProfile(const std::string& which, int runs) {
       const Target t(std::move(copy), target_options);
       CALLGRIND_STOP_INSTRUMENTATION;
       target_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-      graph_size = t.neighborGraph().neighbors.size();
+      graph_size = t.neighborGraph().offsets.size();
     }
     std::sort(target_ms.begin(), target_ms.end());
     std::printf("%s: %zu points, %d runs, median %.2f ms, min %.2f ms (graph entries %zu)\n", which.c_str(),

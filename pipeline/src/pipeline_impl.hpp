@@ -213,7 +213,9 @@ struct Pipeline::Impl {
   std::shared_ptr<const Scan> storedCloud(std::size_t i) const;
   /// Drops the store's reference to clouds before `bound`, keeping the dense window of the last keyframe.
   void releaseBefore(std::size_t bound);
-  void deliver(const std::shared_ptr<const CalibrationDataset>& d, std::size_t lane);
+  /// Hands `d` over: the callback gets the pipeline's only reference (moved), so that whoever it gives it to
+  /// owns the dataset's clouds alone and can free them while the selector waits on it (offline).
+  void deliver(std::shared_ptr<const CalibrationDataset> d, std::size_t lane);
   void selectorStage();
   void waitForMappingLead(TimeNs stamp);
   void mappingIngested(TimeNs stamp, bool done);

@@ -188,9 +188,9 @@ void Pipeline::Impl::releaseBefore(std::size_t bound) {
   for (std::size_t i = 0; i < std::min(bound, stored_clouds.size()); ++i) stored_clouds[i].reset();
 }
 
-void Pipeline::Impl::deliver(const std::shared_ptr<const CalibrationDataset>& d, std::size_t lane) {
+void Pipeline::Impl::deliver(std::shared_ptr<const CalibrationDataset> d, std::size_t lane) {
   lanes[lane]->handed_over.store(true);
-  if (on_dataset) on_dataset(d);
+  if (on_dataset) on_dataset(std::move(d));
 }
 
 void Pipeline::Impl::selectorStage() {
@@ -210,7 +210,7 @@ void Pipeline::Impl::selectorStage() {
         if (auto d = selection[i].finish()) ready.emplace_back(std::move(d), i);
         else if (!selection[i].handedOver()) missing.push_back(selection[i].shortfall());
       }
-      for (auto& [d, i] : ready) deliver(d, i);
+      for (auto& [d, i] : ready) deliver(std::move(d), i);
       std::lock_guard lock(result_mutex);
       shortfalls = std::move(missing);
       return;
@@ -227,7 +227,7 @@ void Pipeline::Impl::selectorStage() {
     lc.selected.store(selection[lane].selected());
     rec_selector.record(t0);
     if (options.observer) options.observer->onCandidate(selection[lane].lastCandidateEvent(int(lane)));
-    if (d) deliver(d, lane);
+    if (d) deliver(std::move(d), lane);
     std::size_t bound = SIZE_MAX;
     for (const auto& s : selection)
       if (auto from = s.neededFrom(kfs)) bound = std::min(bound, *from);

@@ -148,7 +148,7 @@ CovarianceStats shapesAndGraph(PointCloud& cloud, const detail::CellKnn& knn, st
   const std::size_t k_query = knn.k;
   if (graph != nullptr) {
     graph->degree = degree;
-    graph->neighbors.assign(n * degree, 0);
+    graph->offsets.assign(n * degree, 0);
     graph->radius.assign(n, 0.0F);
   }
   cloud.normals.assign(n, Eigen::Vector4d::Zero());
@@ -164,11 +164,12 @@ CovarianceStats shapesAndGraph(PointCloud& cloud, const detail::CellKnn& knn, st
   parallelFor(chunkCount(n, kDefaultChunk), options.num_threads, [&](std::size_t task) {
     if (options.deadline.expired()) return;
     std::size_t local_isolated = 0;
+    std::vector<std::uint32_t> list;
     for (std::size_t i = task * kDefaultChunk; i < std::min(n, (task + 1) * kDefaultChunk); ++i) {
       const Neighbor* nb = knn.neighbors.data() + i * k_query;
       const std::size_t all = knn.count[i];
       if (degree > 0) {
-        std::uint32_t* list = graph->neighbors.data() + i * degree;
+        list.resize(degree);
         std::size_t m = 0, next = all;
         for (std::size_t j = 0; j < all; ++j) {
           if (nb[j].index == i) continue;
@@ -178,7 +179,8 @@ CovarianceStats shapesAndGraph(PointCloud& cloud, const detail::CellKnn& knn, st
           }
           list[m++] = nb[j].index;
         }
-        if (m == degree && next < all) graph->radius[i] = std::sqrt(nb[next].sq_distance);
+        // Fewer than `degree` others, or none beyond them: the list vouches for nothing (radius stays 0).
+        if (m == degree && next < all) graph->set(i, list.data(), std::sqrt(nb[next].sq_distance));
       }
       if (!fillShape(sink, i, nb, std::min(all, k), options.plane_epsilon)) ++local_isolated;
     }

@@ -196,6 +196,15 @@ void checkSelectionRespectsBudgetAndSpacing() {
   for (const auto& l : g->result->progress.lidars) EXPECT_TRUE(l.handed_over) << l.sensor;
 }
 
+// Issue #18: the callback gets the pipeline's only reference to a dataset, so a receiver that owns it (the
+// calibration worker) can free its clouds while the selector waits on it (offline). The selector used to
+// keep its own copy of the pointer through the callback: every cloud lived until the calibration ended.
+void checkHandOverGivesTheOnlyReference() {
+  ASSERT_EQ(g->result->use_counts_at_hand_over.size(), g->result->datasets.size());
+  ASSERT_FALSE(g->result->datasets.empty());
+  for (const long n : g->result->use_counts_at_hand_over) EXPECT_EQ(n, 1);
+}
+
 
 TEST(PipelineSim, ParkingLotSegment) {
   ParkingLot run;
@@ -233,6 +242,10 @@ TEST(PipelineSim, ParkingLotSegment) {
   {
     SCOPED_TRACE("SelectionRespectsBudgetAndSpacing");
     checkSelectionRespectsBudgetAndSpacing();
+  }
+  {
+    SCOPED_TRACE("HandOverGivesTheOnlyReference");
+    checkHandOverGivesTheOnlyReference();
   }
   g = nullptr;
 }

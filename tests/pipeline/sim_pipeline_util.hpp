@@ -23,6 +23,8 @@ inline config::RigConfig rigFor(const sim::Simulation& sim, const std::filesyste
 /// Everything a run produced.
 struct RunResult {
   std::vector<std::shared_ptr<const CalibrationDataset>> datasets;
+  /// Each dataset's use_count() as the callback received it: how many references the pipeline kept.
+  std::vector<long> use_counts_at_hand_over;
   MappingResult mapping;
   PipelineProgress progress;
   PipelineStats stats;
@@ -46,6 +48,7 @@ RunResult runPipeline(const config::RigConfig& rig, const PipelineOptions& optio
   std::mutex m;
   Pipeline pipeline(rig, options, [&](std::shared_ptr<const CalibrationDataset> d) {
     std::lock_guard lock(m);
+    r.use_counts_at_hand_over.push_back(d.use_count());
     r.datasets.push_back(std::move(d));
   });
   feed(pipeline);

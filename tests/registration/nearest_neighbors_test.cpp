@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <random>
 #include <vector>
 
 #include "rigcal/registration/covariance.hpp"
+#include "rigcal/registration/target.hpp"
 #include "scenes.hpp"
 
 namespace rigcal::registration {
@@ -129,10 +131,60 @@ TEST(NeighborGraph, RadiusBoundsEveryUnlistedPoint) {
   estimateCovariances(cloud, tree, options, &graph, 8);
   ASSERT_EQ(graph.degree, 8u);
   for (std::size_t j = 0; j < cloud.size(); j += 37) {
-    const auto listed = graph.of(j);
+    std::vector<std::uint32_t> listed;
+    for (std::size_t r = 0; r < graph.degree; ++r) listed.push_back(graph.neighbor(j, r));
     for (std::size_t k = 0; k < cloud.size(); ++k) {
       if (k == j || std::find(listed.begin(), listed.end(), k) != listed.end()) continue;
       EXPECT_GE((cloud.points[k] - cloud.points[j]).norm(), graph.radius[j] - 1e-5);
+    }
+  }
+}
+
+// Issue #18: a neighbour is stored as a 2-byte offset. One that does not fit is not stored: the point
+// lists itself and vouches for nothing (radius 0), so a search from it goes to the tree.
+TEST(NeighborGraph, AListWithAnOffsetBeyondTwoBytesIsNotStored) {
+  NeighborGraph graph;
+  graph.degree = 2;
+  graph.offsets.assign(2 * 40000, 0);
+  graph.radius.assign(40000, 0.0F);
+  const std::uint32_t near[2] = {3, 7}, far[2] = {1, 5 + 32768};
+  EXPECT_TRUE(graph.set(5, near, 0.5F));
+  EXPECT_EQ(graph.neighbor(5, 0), 3u);
+  EXPECT_EQ(graph.neighbor(5, 1), 7u);
+  EXPECT_EQ(graph.radius[5], 0.5F);
+  EXPECT_FALSE(graph.set(5, far, 0.5F));
+  EXPECT_EQ(graph.neighbor(5, 0), 5u);
+  EXPECT_EQ(graph.neighbor(5, 1), 5u);
+  EXPECT_EQ(graph.radius[5], 0.0F);
+  const std::uint32_t edge[2] = {39999 - 32767, 39999};
+  EXPECT_TRUE(graph.set(39999, edge, 0.25F)) << "offset -32767 and 0 fit";
+  EXPECT_EQ(graph.neighbor(39999, 0), 39999u - 32767u);
+}
+
+// In a Target the points are in the tree's leaf order, so almost every point's neighbours fit in two
+// bytes: the graph keeps doing its job (a handful of points at the top splits vouch for nothing).
+TEST(NeighborGraph, InATargetAlmostEveryPointVouches) {
+  PointCloud cloud = test::room(0.03);
+  ASSERT_GT(cloud.size(), 2u * 32768u) << "offsets must be able to overflow";
+  TargetOptions options;
+  options.normals_and_covariances = true;
+  const Target target(std::move(cloud), options);
+  const NeighborGraph& graph = target.neighborGraph();
+  ASSERT_FALSE(graph.empty());
+  std::size_t vouching = 0;
+  for (const float r : graph.radius) vouching += r > 0.0F ? 1 : 0;
+  const double share = double(vouching) / double(graph.radius.size());
+  std::printf("%zu points, %.2f %% vouch\n", graph.radius.size(), 100.0 * share);
+  EXPECT_GT(share, 0.97);
+  // A stored list is the exact nearest points: every other point is at least its radius away.
+  const auto& pts = target.cloud().points;
+  for (std::size_t j = 0; j < pts.size(); j += 997) {
+    if (graph.radius[j] == 0.0F) continue;
+    std::vector<std::uint32_t> listed;
+    for (std::size_t r = 0; r < graph.degree; ++r) listed.push_back(graph.neighbor(j, r));
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      if (k == j || std::find(listed.begin(), listed.end(), k) != listed.end()) continue;
+      ASSERT_GE((pts[k] - pts[j]).head<3>().norm(), graph.radius[j] - 1e-4) << j << " " << k;
     }
   }
 }

@@ -8,6 +8,7 @@
 #include "lidar_lidar_calibrator.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
+#include "rigcal/calib/lidar_lidar/mapping_cloud_release.hpp"
 
 namespace rigcal::calib {
 
@@ -46,10 +47,10 @@ void frameInformation(const detail::Calibrator& calibrator, const config::Parame
                                                                params.calibration_eval_max_corr_distance, stride);
 }
 
-}  // namespace
-
-LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
-                                     const registration::Deadline& deadline, const LidarLidarOptions& options) {
+/// calibrateLidarLidar; `drop_clouds` is null or `dataset`, whose mapping clouds then go as the targets are built.
+LidarLidarResult calibrate(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
+                           const registration::Deadline& deadline, const LidarLidarOptions& options,
+                           pipeline::CalibrationDataset* drop_clouds) {
   const auto t0 = Clock::now();
   LidarLidarResult out;
   out.mapping_sensor = dataset.mapping_sensor;
@@ -67,8 +68,10 @@ LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset
           : deadline;
   if (out.failure.empty()) {
     try {
-      detail::Calibrator calibrator(dataset, params, calibration_deadline, options, out);
+      detail::Calibrator calibrator(dataset, params, calibration_deadline, options, out, drop_clouds);
       calibrator.run();
+      // A plan cut before its last target: the clouds of the frames never built go too.
+      if (drop_clouds != nullptr) dropMappingCloudsDoneWith(*drop_clouds, dataset.frames.size());
       if (out.ok) frameInformation(calibrator, params, out);
       if (options.trajectory_clock && out.ok) out.trajectory_clock = trajectoryClock(dataset, calibrator, out, deadline, options);
     } catch (const std::exception& e) {  // a bad dataset the validation did not foresee: a clear failure
@@ -86,6 +89,19 @@ LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset
   }
   judgeLidarLidar(out, dataset.frames.size(), params.calibration_deadline_s);
   return out;
+}
+
+}  // namespace
+
+LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
+                                     const registration::Deadline& deadline, const LidarLidarOptions& options) {
+  return calibrate(dataset, params, deadline, options, nullptr);
+}
+
+LidarLidarResult calibrateLidarLidarDroppingClouds(pipeline::CalibrationDataset& dataset, const config::Parameters& params,
+                                                   const registration::Deadline& deadline,
+                                                   const LidarLidarOptions& options) {
+  return calibrate(dataset, params, deadline, options, &dataset);
 }
 
 }  // namespace rigcal::calib

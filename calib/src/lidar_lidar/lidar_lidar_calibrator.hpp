@@ -42,9 +42,11 @@ enum class FrameBuild { kBuilt, kSkipped, kOutOfTime };
 
 class Calibrator {
  public:
+  /// `drop_clouds`: null, or `dataset` itself when its owner lets each mapping cloud go once the last target
+  /// built from it exists (calibrateLidarLidarDroppingClouds).
   Calibrator(const pipeline::CalibrationDataset& dataset, const config::Parameters& params, const Deadline& deadline,
-             const LidarLidarOptions& options, LidarLidarResult& out)
-      : data_(dataset), params_(params), deadline_(deadline), opt_(options), out_(out) {}
+             const LidarLidarOptions& options, LidarLidarResult& out, pipeline::CalibrationDataset* drop_clouds = nullptr)
+      : data_(dataset), params_(params), deadline_(deadline), opt_(options), out_(out), drop_clouds_(drop_clouds) {}
 
   void run();
 
@@ -72,6 +74,7 @@ class Calibrator {
   /// Source and augmented target of dataset frame i; a frame without enough points is skipped (noted).
   /// Out of time when the target's build would leave less than `reserve` seconds.
   FrameBuild buildFrame(std::size_t i, double reserve = 0.0);
+  FrameBuild buildFrameTarget(std::size_t i, double reserve);  // buildFrame's work, before the clouds' release
 
   /// The initial guess's and the best's scores over the frames built so far (the set just grew).
   void rescore();
@@ -119,6 +122,7 @@ class Calibrator {
   const Deadline& deadline_;
   const LidarLidarOptions& opt_;
   LidarLidarResult& out_;
+  pipeline::CalibrationDataset* drop_clouds_;
   std::vector<Frame> frames_;
   struct StageSeconds {
     double targets = 0.0, ensemble = 0.0, batched = 0.0, redeskew_final = 0.0;

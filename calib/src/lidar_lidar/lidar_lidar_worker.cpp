@@ -63,15 +63,21 @@ void LidarLidarWorker::loop() {
       pending_.pop_front();
       ++started_;
     }
+    // The worker's own copy (the clouds are shared, not copied): with the pipeline's reference gone at the
+    // hand-over, it alone holds the clouds no other lane or the pipeline's store still needs, and can let
+    // each go once its targets are built rather than after the whole calibration.
+    pipeline::CalibrationDataset owned = *dataset;
+    dataset.reset();
     // The pipeline's freed clouds before the targets are built; the targets (and clouds) once freed.
     releaseFreedHeap();
     const auto t0 = std::chrono::steady_clock::now();
-    LidarLidarResult result = calibrateLidarLidar(*dataset, params_, budget_.next(), options_);
+    LidarLidarResult result = keep_mapping_clouds_
+                                  ? calibrateLidarLidar(owned, params_, budget_.next(), options_)
+                                  : calibrateLidarLidarDroppingClouds(owned, params_, budget_.next(), options_);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     results.push_back(std::move(result));
-    datasets.push_back(*dataset);
-    if (!keep_mapping_clouds_) datasets.back().mapping_clouds = {};
-    dataset.reset();  // the pipeline's reference went with the hand-over: the clouds can go now
+    if (!keep_mapping_clouds_) owned.mapping_clouds = {};
+    datasets.push_back(std::move(owned));
     releaseFreedHeap();
     {
       const std::lock_guard lock(mutex_);

@@ -166,7 +166,8 @@ struct SensorInput {
 class Pipeline {
  public:
   /// Called on the selector thread, once per calibration lidar. Return quickly (hand the dataset to
-  /// another thread): the selector waits for it.
+  /// another thread): the selector waits for it. The pointer is the pipeline's only reference (it keeps
+  /// none): a receiver that drops it frees the dataset's clouds the pipeline does not store any more.
   using DatasetCallback = std::function<void(std::shared_ptr<const CalibrationDataset>)>;
 
   /// Starts the stage threads. Throws std::runtime_error (one line) when a sensor of the rig cannot be

@@ -27,14 +27,38 @@ struct Neighbor {
 /// Each point's nearest other points (a by-product of the covariance pass). Every point of the cloud
 /// that is not listed for j is at least radius[j] from point j, which lets a search that starts at a
 /// previous match prove its answer exact without touching the tree (see the ICP matcher).
+///
+/// A neighbour is stored as its offset from j, 2 bytes instead of a 4-byte index (issue #18: 20 of a
+/// calibration target's ~150 bytes a point): a Target's points are in its tree's leaf order, so a point's
+/// neighbours sit near it in the array. A point with a neighbour beyond ±32767 places lists itself instead
+/// (offsets 0) and has radius 0, like a point with fewer than `degree` others: it vouches for nothing and
+/// the tree answers its searches. The answers stay exact; only how often the tree is asked changes.
 struct NeighborGraph {
-  std::size_t degree = 0;                // entries per point
-  std::vector<std::uint32_t> neighbors;  // degree × size, closest first
-  std::vector<float> radius;             // per point; 0 when it cannot vouch for anything
+  static constexpr std::int32_t kMaxOffset = 32767;
+  std::size_t degree = 0;              // entries per point
+  std::vector<std::int16_t> offsets;   // degree × size, closest first: neighbour r of j is j + offsets[j·degree + r]
+  std::vector<float> radius;           // per point; 0 when it cannot vouch for anything
 
   [[nodiscard]] bool empty() const { return degree == 0 || radius.empty(); }
-  [[nodiscard]] std::span<const std::uint32_t> of(std::size_t j) const {
-    return {neighbors.data() + j * degree, degree};
+  /// Neighbour r (closest first) of point j; j itself where the list could not be stored.
+  [[nodiscard]] std::uint32_t neighbor(std::size_t j, std::size_t r) const {
+    return static_cast<std::uint32_t>(static_cast<std::int64_t>(j) + offsets[j * degree + r]);
+  }
+  /// Point j's list (`degree` entries, closest first) and the radius it vouches for; a list with an offset
+  /// out of range is not stored (j then vouches for nothing). False when it was not.
+  bool set(std::size_t j, const std::uint32_t* list, float radius_j) {
+    std::int16_t* out = offsets.data() + j * degree;
+    for (std::size_t r = 0; r < degree; ++r) {
+      const std::int64_t d = static_cast<std::int64_t>(list[r]) - static_cast<std::int64_t>(j);
+      if (d < -kMaxOffset || d > kMaxOffset) {
+        for (std::size_t q = 0; q < degree; ++q) out[q] = 0;
+        radius[j] = 0.0F;
+        return false;
+      }
+      out[r] = static_cast<std::int16_t>(d);
+    }
+    radius[j] = radius_j;
+    return true;
   }
 };
 

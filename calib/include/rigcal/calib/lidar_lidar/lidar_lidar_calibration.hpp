@@ -119,4 +119,11 @@ std::string validateDataset(const pipeline::CalibrationDataset& dataset, const c
 LidarLidarResult calibrateLidarLidar(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
                                      const registration::Deadline& deadline, const LidarLidarOptions& options = {});
 
+/// calibrateLidarLidar for an owner of `dataset` that needs none of its mapping clouds afterwards
+/// (LidarLidarWorker without keep_mapping_clouds): each cloud is reset as soon as the last target built from
+/// it exists (dropMappingCloudsDoneWith), the rest when the calibration ends. The same result.
+LidarLidarResult calibrateLidarLidarDroppingClouds(pipeline::CalibrationDataset& dataset, const config::Parameters& params,
+                                                   const registration::Deadline& deadline,
+                                                   const LidarLidarOptions& options = {});
+
 }  // namespace rigcal::calib

@@ -23,7 +23,10 @@ class LidarLidarWorker {
   /// `calibration_lidars`: how many datasets may come (the rig's calibration lidars).
   /// `keep_mapping_clouds` false: `datasets` keeps each dataset without its mapping clouds once it is
   /// calibrated, for a caller with a map of its own. They are most of a dataset's bytes, and the lidars
-  /// calibrated after it (the rest of the drive) would otherwise hold them too.
+  /// calibrated after it (the rest of the drive) would otherwise hold them too. The worker then also lets
+  /// each cloud go during the calibration, once the last target built from it exists
+  /// (calibrateLidarLidarDroppingClouds): it owns the dataset from the hand-over on (add() should get the
+  /// only reference; the clouds another holder keeps are not freed).
   LidarLidarWorker(const config::Parameters& params, std::size_t calibration_lidars,
                    const LidarLidarOptions& options = {}, const registration::CancelToken* cancel = nullptr,
                    bool keep_mapping_clouds = true);
