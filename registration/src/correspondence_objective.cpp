@@ -80,15 +80,13 @@ bool CorrespondenceObjective::graphSearch(const Target& target, std::uint32_t st
   const Eigen::Vector4f ql = target.tree().toLocal(q);
   const float slack = 1e-4F + 4e-7F * ql.cwiseAbs().maxCoeff();
   const NeighborGraph& graph = target.neighborGraph();
-  const std::size_t degree = graph.degree;
   std::uint32_t c = start;
   for (int hop = 0; hop < kMaxHops; ++hop) {
     const float dc2 = (ql - pts[c]).squaredNorm();
     std::uint32_t best = c;
     float best2 = dc2, second2 = std::numeric_limits<float>::infinity();
-    const std::int16_t* offsets = graph.offsets.data() + std::size_t(c) * degree;
-    for (std::size_t r = 0; r < degree; ++r) {
-      const std::uint32_t k = c + static_cast<std::uint32_t>(static_cast<std::int32_t>(offsets[r]));
+    for (std::size_t r = 0; r < graph.degree; ++r) {
+      const std::uint32_t k = graph.neighbor(c, r);
       const float d2 = (ql - pts[k]).squaredNorm();
       if (d2 < best2) {
         second2 = best2;
