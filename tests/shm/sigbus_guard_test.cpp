@@ -53,15 +53,16 @@ TEST(TruncationShield, AMappingTruncatedByAnotherProcessReadsZerosInsteadOfASigb
 
 TEST(TruncationShieldDeathTest, ASigbusOutsideEveryShieldStillKills) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
-  rigcal::test::TempDir dir;
-  const std::filesystem::path file = dir / "mapping";
   const long page = ::sysconf(_SC_PAGESIZE);
-  { std::ofstream(file) << std::string(std::size_t(2 * page), 'x'); }
   EXPECT_DEATH(
       {
         int other = 0;
         detail::TruncationShield elsewhere(&other, sizeof other);  // the handler is installed
-        const int fd = ::open(file.c_str(), O_RDWR);
+        // An unnamed file: the child dies here, so nothing it named would be removed (a TempDir was left in /tmp).
+        std::FILE* file = std::tmpfile();
+        if (file == nullptr) std::abort();
+        const int fd = ::fileno(file);
+        if (::ftruncate(fd, 2 * page) != 0) std::abort();
         auto* base = static_cast<volatile unsigned char*>(
             ::mmap(nullptr, std::size_t(2 * page), PROT_READ, MAP_SHARED, fd, 0));
         if (::ftruncate(fd, 0) != 0) std::abort();
