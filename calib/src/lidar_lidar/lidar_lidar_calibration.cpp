@@ -68,10 +68,13 @@ LidarLidarResult calibrate(const pipeline::CalibrationDataset& dataset, const co
           : deadline;
   if (out.failure.empty()) {
     try {
-      detail::Calibrator calibrator(dataset, params, calibration_deadline, options, out, drop_clouds);
+      detail::Calibrator::TargetsDone release;
+      if (drop_clouds != nullptr)
+        release = [drop_clouds](std::size_t first_pending) { dropMappingCloudsDoneWith(*drop_clouds, first_pending); };
+      detail::Calibrator calibrator(dataset, params, calibration_deadline, options, out, release);
       calibrator.run();
       // A plan cut before its last target: the clouds of the frames never built go too.
-      if (drop_clouds != nullptr) dropMappingCloudsDoneWith(*drop_clouds, dataset.frames.size());
+      if (release) release(dataset.frames.size());
       if (out.ok) frameInformation(calibrator, params, out);
       if (options.trajectory_clock && out.ok) out.trajectory_clock = trajectoryClock(dataset, calibrator, out, deadline, options);
     } catch (const std::exception& e) {  // a bad dataset the validation did not foresee: a clear failure

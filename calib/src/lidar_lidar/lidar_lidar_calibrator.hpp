@@ -5,6 +5,7 @@
 // (lidar_lidar_ensemble.cpp). Private to calib/.
 #include <chrono>
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <set>
 #include <tuple>
@@ -42,11 +43,15 @@ enum class FrameBuild { kBuilt, kSkipped, kOutOfTime };
 
 class Calibrator {
  public:
-  /// `drop_clouds`: null, or `dataset` itself when its owner lets each mapping cloud go once the last target
-  /// built from it exists (calibrateLidarLidarDroppingClouds).
+  /// Called after each frame's target was tried, with the first frame whose target is still to come
+  /// (frames.size(): none will be built); the dataset's owner may then let go of what only those targets read
+  /// (calibrateLidarLidarDroppingClouds: the mapping clouds). Frames are built in order.
+  using TargetsDone = std::function<void(std::size_t first_pending)>;
+
   Calibrator(const pipeline::CalibrationDataset& dataset, const config::Parameters& params, const Deadline& deadline,
-             const LidarLidarOptions& options, LidarLidarResult& out, pipeline::CalibrationDataset* drop_clouds = nullptr)
-      : data_(dataset), params_(params), deadline_(deadline), opt_(options), out_(out), drop_clouds_(drop_clouds) {}
+             const LidarLidarOptions& options, LidarLidarResult& out, TargetsDone targets_done = {})
+      : data_(dataset), params_(params), deadline_(deadline), opt_(options), out_(out),
+        targets_done_(std::move(targets_done)) {}
 
   void run();
 
@@ -122,7 +127,7 @@ class Calibrator {
   const Deadline& deadline_;
   const LidarLidarOptions& opt_;
   LidarLidarResult& out_;
-  pipeline::CalibrationDataset* drop_clouds_;
+  TargetsDone targets_done_;
   std::vector<Frame> frames_;
   struct StageSeconds {
     double targets = 0.0, ensemble = 0.0, batched = 0.0, redeskew_final = 0.0;

@@ -9,7 +9,6 @@
 #include "rigcal/calib/lidar_lidar/augmented_target.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_source.hpp"
-#include "rigcal/calib/lidar_lidar/mapping_cloud_release.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
 
 namespace rigcal::calib::detail {
@@ -31,10 +30,9 @@ double firstTargetLeaf(double leaf, double seconds, double allowed) {
 
 FrameBuild Calibrator::buildFrame(std::size_t i, double reserve) {
   const FrameBuild built = buildFrameTarget(i, reserve);
-  // Frames are built in order and none after one that ran out of time: the clouds no later frame names
-  // are not read again (issue #18: front_left's ~100 clouds lived through its whole calibration).
-  if (drop_clouds_ != nullptr)
-    dropMappingCloudsDoneWith(*drop_clouds_, built == FrameBuild::kOutOfTime ? data_.frames.size() : i + 1);
+  // Frames are built in order and none after one that ran out of time: what only the earlier targets read
+  // can go now (issue #18: front_left's ~100 mapping clouds had lived through its whole calibration).
+  if (targets_done_) targets_done_(built == FrameBuild::kOutOfTime ? data_.frames.size() : i + 1);
   return built;
 }
 
