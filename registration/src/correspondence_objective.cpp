@@ -184,16 +184,16 @@ void CorrespondenceObjective::hold(std::size_t g, const Target& target, std::uin
 }
 
 template <Residual K>
-double CorrespondenceObjective::costTerm(std::size_t g, const Eigen::Vector3d& r, const PointCloud& tc,
+double CorrespondenceObjective::costTerm(std::size_t g, const Eigen::Vector3d& r, const Target& target,
                                          std::uint32_t j) const {
   if constexpr (K == Residual::kPointToPlane) {
-    const double e = tc.normals[j].head<3>().dot(r);
+    const double e = target.normal(j).dot(r);
     return e * e;
   } else if constexpr (K == Residual::kGicp) {
-    (void)tc, (void)j;
+    (void)target, (void)j;
     return r.dot(weight_[g].times(r));
   } else {
-    (void)g, (void)tc, (void)j;
+    (void)g, (void)target, (void)j;
     return r.squaredNorm();
   }
 }
@@ -202,7 +202,6 @@ template <Residual K, bool kPrevious>
 CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const PairChunk& chunk,
                                                                       const Eigen::Matrix4d& M) {
   const Target& target = *pairs_[chunk.pair].target;
-  const PointCloud& tc = target.cloud();
   const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();
   Pass out;
   LinearSystem& sys = out.sys;
@@ -214,7 +213,7 @@ CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const Pair
     if constexpr (kPrevious) {  // exactly costChunk's term: the acceptance test sees the same number
       const std::uint32_t previous = used_[g];
       if (previous != kNone) {
-        out.previous_cost += costTerm<K>(g, q4.head<3>() - targetPoint(g, tc, previous), tc, previous);
+        out.previous_cost += costTerm<K>(g, q4.head<3>() - targetPoint(g, target, previous), target, previous);
       }
     }
     std::uint32_t j = kNone;
@@ -226,7 +225,7 @@ CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const Pair
     const double d2 = r.squaredNorm();
     if (d2 > max_sq_) continue;  // exact distance just outside the (float) search radius
     if constexpr (K == Residual::kPointToPlane) {
-      const Eigen::Vector3d n = tc.normals[j].head<3>();
+      const Eigen::Vector3d n = target.normal(j);
       if (n.squaredNorm() < 0.5) continue;  // no normal known there
       const double e = n.dot(r);
       Vector6d row;
@@ -259,13 +258,13 @@ CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const Pair
 
 template <Residual K>
 double CorrespondenceObjective::costChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) const {
-  const PointCloud& tc = pairs_[chunk.pair].target->cloud();
+  const Target& target = *pairs_[chunk.pair].target;
   double cost = 0.0;
   for (std::size_t i = chunk.begin; i < chunk.end; i += stride_) {
     const std::size_t g = chunk.offset + (i - chunk.begin);
     const std::uint32_t j = used_[g];  // the same matches as the linearisation: the cost is comparable
     if (j == kNone) continue;
-    cost += costTerm<K>(g, (M * source_points_[g]).head<3>() - targetPoint(g, tc, j), tc, j);
+    cost += costTerm<K>(g, (M * source_points_[g]).head<3>() - targetPoint(g, target, j), target, j);
   }
   return cost;
 }
@@ -326,7 +325,7 @@ std::optional<LinearSystem> CorrespondenceObjective::measure(const Pose& T, cons
       const Eigen::Vector4d q = M * source_points_[g];
       std::uint32_t j = kNone;
       if (!match(target, g, q, &j)) continue;
-      const double d2 = (q.head<3>() - targetPoint(g, target.cloud(), j)).squaredNorm();
+      const double d2 = (q.head<3>() - targetPoint(g, target, j)).squaredNorm();
       if (d2 > max_sq_) continue;
       ++part.inliers;
       part.sum_sq_distance += d2;

@@ -48,7 +48,7 @@ class CorrespondenceObjective final : public Objective {
   double costChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) const;
   /// Source point g's cost term for residual r against target point j, with the current weights.
   template <Residual K>
-  double costTerm(std::size_t g, const Eigen::Vector3d& r, const PointCloud& tc, std::uint32_t j) const;
+  double costTerm(std::size_t g, const Eigen::Vector3d& r, const Target& target, std::uint32_t j) const;
 
   /// The nearest target point of source point g (global index) at q, reusing the last one when q has
   /// moved less than half the gap between the last nearest and second-nearest distances: then, by the
@@ -61,8 +61,8 @@ class CorrespondenceObjective final : public Objective {
                    float* margin) const;
 
   /// The target point j for source point g: from held_ when it holds j.
-  [[nodiscard]] Eigen::Vector3d targetPoint(std::size_t g, const PointCloud& tc, std::uint32_t j) const {
-    return held_[g].index == j ? held_[g].point : Eigen::Vector3d(tc.points[j].head<3>());
+  [[nodiscard]] Eigen::Vector3d targetPoint(std::size_t g, const Target& target, std::uint32_t j) const {
+    return held_[g].index == j ? held_[g].point : Eigen::Vector3d(target.cloud().points[j].head<3>());
   }
   /// Makes held_[g] hold target point j.
   void hold(std::size_t g, const Target& target, std::uint32_t j);

@@ -35,7 +35,7 @@ double conditioning(std::span<const SourceTarget> pairs, const Pose& T, double m
       const Eigen::Vector3d x = target->cloud().points[hit.index].head<3>();
       Eigen::Vector3d n;
       if (target->hasNormals()) {
-        n = target->cloud().normals[hit.index].head<3>();
+        n = target->normal(hit.index);
       } else {
         const std::size_t found = target->tree().knn(target->cloud().points[hit.index], kNormalNeighbors, nb);
         if (found < 5) continue;

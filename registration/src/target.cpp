@@ -63,6 +63,11 @@ Target::Target(PointCloud cloud, const TargetOptions& options) : cloud_(std::mov
     stopped_ = true;
     return;
   }
+  if (cloud_.hasNormals()) {
+    normals_float_.reserve(cloud_.size());
+    for (const Eigen::Vector4d& n : cloud_.normals) normals_float_.push_back(n.head<3>().cast<float>());
+    std::vector<Eigen::Vector4d>().swap(cloud_.normals);
+  }
   if (cloud_.hasCovariances()) {
     // Covariances the cloud came with. Only the compact float form is read (GICP): the 4x4 matrices
     // (128 bytes a point) are dropped, which on a calibration's ~10 targets is most of its memory.

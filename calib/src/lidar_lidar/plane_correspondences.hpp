@@ -18,14 +18,13 @@ namespace rigcal::calib::detail {
 template <class Fn>
 void forEachPlaneCorrespondence(const registration::Target& target, const registration::PointCloud& source,
                                 const Pose& T, double max_distance, std::size_t stride, Fn&& fn) {
-  const auto& normals = target.cloud().normals;
-  if (normals.empty()) return;
+  if (!target.hasNormals()) return;
   for (std::size_t i = 0; i < source.points.size(); i += std::max<std::size_t>(1, stride)) {
     const Eigen::Vector3d p = source.points[i].head<3>();
     const Eigen::Vector4d q = (T * p).homogeneous();
     registration::Neighbor nb;
     if (!target.tree().nearest(q, max_distance * max_distance, &nb)) continue;
-    const Eigen::Vector3d n = normals[nb.index].head<3>();
+    const Eigen::Vector3d n = target.normal(nb.index);
     if (n.squaredNorm() < 0.5) continue;  // no normal estimated there
     fn(p, Eigen::Vector3d(q.head<3>()), n);
   }

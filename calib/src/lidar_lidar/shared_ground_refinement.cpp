@@ -186,7 +186,6 @@ SharedGroundRefinement SharedGroundReference::refine(const Scan& source_scan, co
                   " voxels)");
   const registration::Target& tgt = *impl_->structure;
   const auto& tp = tgt.cloud().points;
-  const auto& tn = tgt.cloud().normals;
   constexpr double kHuber = 0.02;  // m: residuals beyond this weigh less (edges, what one lidar sees only)
   std::size_t matches = 0;
   for (double dist = s.max_correspondence; dist >= s.min_correspondence * 0.999; dist /= 2) {
@@ -198,7 +197,7 @@ SharedGroundRefinement SharedGroundReference::refine(const Scan& source_scan, co
         const Eigen::Vector3d q = R * ps.head<3>() + t;
         registration::Neighbor nb;
         if (!tgt.tree().nearest(q.homogeneous(), dist * dist, &nb)) continue;
-        const Eigen::Vector3d m = tn[nb.index].head<3>();
+        const Eigen::Vector3d m = tgt.normal(nb.index);
         if (m.squaredNorm() < 0.5) continue;  // no normal there
         const double r = m.dot(q - tp[nb.index].head<3>());
         const Eigen::Vector3d J(m.dot(n.cross(q - t)), m.dot(e1), m.dot(e2));

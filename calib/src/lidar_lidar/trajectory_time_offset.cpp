@@ -54,7 +54,7 @@ Pass linearise(std::vector<FrameData>& frames, const std::vector<Pose>& D, const
         continue;
       }
       f.hints[i] = nb.index;
-      const Eigen::Vector3d n = cloud.normals[nb.index].head<3>();
+      const Eigen::Vector3d n = f.target->normal(nb.index);
       const Eigen::Vector3d d = q.head<3>() - cloud.points[nb.index].head<3>();
       if (n.squaredNorm() < 0.5) {  // no normal there: the point distance, not fitted
         pass.frame_cost[k] += std::min(d.squaredNorm(), c2);
