@@ -143,7 +143,7 @@ struct Pipeline::Impl {
   std::vector<MappingFrame> trajectory;
   mutable std::mutex store_mutex;
   std::vector<MappingFrame> stored_frames;
-  std::vector<std::shared_ptr<const Scan>> stored_clouds;  // nullptr once released
+  std::vector<std::shared_ptr<const Scan>> stored_clouds;  // keyframes' clouds; nullptr once released and for other frames
   std::vector<std::size_t> stored_keyframes;
 
   // Results of the selector.

@@ -34,21 +34,16 @@ std::shared_ptr<const CalibrationDataset> SelectionLane::add(CandidateMessage ca
 }
 
 std::vector<std::pair<std::size_t, MappingCloud>> SelectionLane::windowPicks(const CandidateMessage& c,
-                                                                             const CloudLookup& clouds) {
+                                                                             const CloudLookup& clouds) const {
   const std::vector<MappingFrame>* frames = c.frames.get();
-  std::vector<std::pair<std::size_t, std::shared_ptr<const Scan>>> stored;  // the whole window, briefly
-  std::size_t own = SIZE_MAX;
-  if (frames == nullptr) return {};
-  for (std::size_t i = c.window_begin; i <= c.window_end && i < frames->size(); ++i) {
-    auto cloud = clouds(i);
-    if (!cloud) continue;
-    if (i == c.pairing.keyframe_frame) own = stored.size();
-    stored.emplace_back(i, std::move(cloud));
-  }
+  if (frames == nullptr || c.pairing.keyframe_frame >= frames->size()) return {};
+  const int own = (*frames)[c.pairing.keyframe_frame].keyframe_index;
+  const int stride = targetKeyframeStride(params_.dense_pointcloud_num_keyframes, kTargetWindowClouds);
   std::vector<std::pair<std::size_t, MappingCloud>> picked;
-  for (const std::size_t k : spreadWindowPicks(stored.size(), own, kTargetWindowClouds)) {
-    auto& [i, cloud] = stored[k];
-    picked.push_back({i, MappingCloud{(*frames)[i], std::move(cloud)}});
+  for (std::size_t i = c.window_begin; i <= c.window_end && i < frames->size(); ++i) {
+    if (!isTargetCloud((*frames)[i], own, stride)) continue;
+    auto cloud = clouds(i);
+    if (cloud) picked.push_back({i, MappingCloud{(*frames)[i], std::move(cloud)}});
   }
   return picked;
 }

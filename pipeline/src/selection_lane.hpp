@@ -46,9 +46,9 @@ class SelectionLane {
     CandidateMessage c;  // c.frames is reset: the lane keeps the latest snapshot only (trajectory_)
     std::vector<std::pair<std::size_t, MappingCloud>> window;  // its target's clouds, by stored index
   };
-  /// The clouds of the candidate's dense window its target would be built from.
-  static std::vector<std::pair<std::size_t, MappingCloud>> windowPicks(const CandidateMessage& c,
-                                                                        const CloudLookup& clouds);
+  /// The clouds of the candidate's dense window its target would be built from (isTargetCloud()).
+  std::vector<std::pair<std::size_t, MappingCloud>> windowPicks(const CandidateMessage& c,
+                                                                 const CloudLookup& clouds) const;
   /// A candidate that can never be selected: only its pairing is kept.
   static void release(Record& r);
   void reselect();

@@ -5,6 +5,20 @@
 
 namespace rigcal::pipeline {
 
+int targetKeyframeStride(int window_keyframes, std::size_t max_picks) {
+  const int n = std::max(0, window_keyframes);
+  const int on_stride_allowed = int(std::max<std::size_t>(max_picks, 2)) - 1;
+  // A window of 2n + 1 keyframes holds at most 2n / stride + 1 keyframes on the stride.
+  int stride = 1;
+  while (2 * n / stride + 1 > on_stride_allowed) ++stride;
+  return stride;
+}
+
+bool isTargetCloud(const MappingFrame& f, int own_keyframe, int stride) {
+  if (!f.isKeyframe() || f.keyframe_index < 0) return false;
+  return f.keyframe_index == own_keyframe || f.keyframe_index % std::max(1, stride) == 0;
+}
+
 std::vector<std::size_t> spreadWindowPicks(std::size_t count, std::size_t own, std::size_t max_picks) {
   std::vector<std::size_t> picked;
   if (max_picks == 0 || count <= max_picks) {

@@ -1,7 +1,8 @@
 // SelectionLane (pipeline/src): what a calibration lidar's lane keeps while it waits for its frame budget
 // (issue #18, peak memory). A candidate that may still be selected keeps only the mapping clouds its target
-// would be built from (at most kTargetWindowClouds of its ~150-cloud window), one that never can keeps no
-// scan, and the hand-over carries each selected frame's picks.
+// would be built from (every other keyframe of its ~200-cloud window and its own: at most
+// kTargetWindowClouds), neighbouring candidates share them, one that never can keeps no scan, and the
+// hand-over carries each selected frame's picks.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -85,10 +86,26 @@ struct Drive {
 TEST(SelectionLane, ACandidateKeepsOnlyTheCloudsItsTargetWouldBeBuiltFrom) {
   Drive drive;
   SelectionLane lane("top", "front", Pose::Identity(), Pose::Identity(), drive.params);
-  // Keyframe 15's window is keyframes 5..25: 201 stored frames.
+  // Keyframe 15's window is keyframes 5..25: 201 stored frames, of which it keeps keyframes 6, 8, .., 24
+  // (every other one) and its own.
   ASSERT_EQ(lane.add(drive.candidate(15, true, 1.0), drive.lookup()), nullptr);
   drive.store.clear();  // the pipeline's store moved on: only what the lane holds is left
-  EXPECT_EQ(drive.cloudsHeld(), kTargetWindowClouds) << "of a 201-cloud window";
+  EXPECT_EQ(drive.cloudsHeld(), 11u) << "of a 201-cloud window";
+  for (int k = 5; k <= 25; ++k) {
+    const bool kept = !drive.watched[std::size_t(k * kFramesPerKeyframe)].expired();
+    EXPECT_EQ(kept, k % 2 == 0 || k == 15) << "keyframe " << k;
+  }
+}
+
+TEST(SelectionLane, NeighbouringCandidatesShareTheirClouds) {
+  Drive drive;
+  drive.params.lidar_calibration_max_frames = 10;  // none is handed over: the lane holds all three
+  SelectionLane lane("top", "front", Pose::Identity(), Pose::Identity(), drive.params);
+  for (const int k : {14, 15, 16}) ASSERT_EQ(lane.add(drive.candidate(k, true, 1.0), drive.lookup()), nullptr);
+  drive.store.clear();
+  // Keyframes 4..26 on the stride (12) and 15, each held once: picks spread within each window had held
+  // 3 x 12 different clouds.
+  EXPECT_EQ(drive.cloudsHeld(), 13u);
 }
 
 TEST(SelectionLane, ACandidateThatCanNeverBeSelectedKeepsNoScanNorCloud) {
@@ -114,14 +131,14 @@ TEST(SelectionLane, TheHandOverCarriesEachSelectedFramesPicksAndTheLaneKeepsNoth
   const std::weak_ptr<const Scan> unselected_raw = later_flat.raw;
   ASSERT_EQ(lane.add(drive.candidate(12, true, 1.0), drive.lookup()), nullptr);
   ASSERT_EQ(lane.add(std::move(later_flat), drive.lookup()), nullptr);
-  // Keyframe 18's window (8..28) overlaps keyframe 12's (2..22): its picks fall between keyframe 12's.
+  // Keyframe 18's window (8..28) overlaps keyframe 12's (2..22): they share keyframes 8, 10, .., 22.
   const auto d = lane.add(drive.candidate(18, true, 1.0), drive.lookup());
   ASSERT_NE(d, nullptr) << "the budget of 2 frames is full";
   ASSERT_EQ(d->frames.size(), 2u);
   EXPECT_TRUE(unselected_raw.expired());
   std::vector<std::uint64_t> all;
   for (const auto& f : d->frames) {
-    ASSERT_EQ(f.window.size(), kTargetWindowClouds);
+    ASSERT_EQ(f.window.size(), 11u);
     std::vector<std::uint64_t> sequences;
     for (const std::size_t i : f.window) {
       ASSERT_LT(i, d->mapping_clouds.size());
@@ -129,7 +146,7 @@ TEST(SelectionLane, TheHandOverCarriesEachSelectedFramesPicksAndTheLaneKeepsNoth
       EXPECT_EQ(d->mapping_clouds[i].cloud->sequence, d->mapping_clouds[i].frame.sequence);
     }
     EXPECT_TRUE(std::is_sorted(sequences.begin(), sequences.end()));
-    // Its own keyframe's cloud, and the window's first and last stored frames.
+    // Its own keyframe's cloud, and the window's first and last keyframes.
     const std::uint64_t own = d->trajectory[f.pairing.keyframe_frame].sequence;
     const int k = d->trajectory[f.pairing.keyframe_frame].keyframe_index;
     EXPECT_NE(std::find(sequences.begin(), sequences.end(), own), sequences.end()) << "keyframe " << k;
@@ -139,9 +156,30 @@ TEST(SelectionLane, TheHandOverCarriesEachSelectedFramesPicksAndTheLaneKeepsNoth
   // The hand-over's clouds are the two frames' picks, each once, by sequence.
   for (std::size_t i = 1; i < d->mapping_clouds.size(); ++i)
     EXPECT_LT(d->mapping_clouds[i - 1].frame.sequence, d->mapping_clouds[i].frame.sequence);
-  EXPECT_LE(d->mapping_clouds.size(), 2 * kTargetWindowClouds);
+  EXPECT_EQ(d->mapping_clouds.size(), 14u) << "keyframes 2, 4, .., 28: the windows share 8 of their 11";
   drive.store.clear();
   EXPECT_EQ(drive.cloudsHeld(), d->mapping_clouds.size()) << "the lane keeps none after the hand-over";
+}
+
+TEST(TargetWindowPicks, EveryStrideThKeyframeAndTheFramesOwn) {
+  EXPECT_EQ(targetKeyframeStride(10, 12), 2) << "the defaults: 11 keyframes of 21, and the own";
+  EXPECT_EQ(targetKeyframeStride(20, 12), 4);
+  EXPECT_EQ(targetKeyframeStride(5, 12), 1) << "a window of 11 keyframes fits whole";
+  EXPECT_EQ(targetKeyframeStride(0, 12), 1);
+  EXPECT_EQ(targetKeyframeStride(10, 0), 21) << "no room: one keyframe a window, and the own";
+  MappingFrame f;
+  f.kind = FrameKind::kKeyframe;
+  f.keyframe_index = 8;
+  EXPECT_TRUE(isTargetCloud(f, 15, 2));
+  f.keyframe_index = 9;
+  EXPECT_FALSE(isTargetCloud(f, 15, 2));
+  EXPECT_TRUE(isTargetCloud(f, 9, 2)) << "its own";
+  f.kind = FrameKind::kStoppedKeyframe;
+  f.keyframe_index = 10;
+  EXPECT_TRUE(isTargetCloud(f, 15, 2));
+  f.kind = FrameKind::kFrame;
+  f.keyframe_index = -1;
+  EXPECT_FALSE(isTargetCloud(f, 15, 1)) << "ordinary stored frames are never picked";
 }
 
 TEST(TargetWindowPicks, EvenlySpreadWithTheKeyframesOwnCloud) {

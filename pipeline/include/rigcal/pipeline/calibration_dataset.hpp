@@ -32,8 +32,8 @@ struct CalibrationFrame {
   std::shared_ptr<const Scan> deskewed;
   double information = 0.0;              // pcaInformation() of `deskewed`
   /// The mapping clouds its target is built from: indices into CalibrationDataset::mapping_clouds, by
-  /// sequence (spreadWindowPicks() over its window, target_window_picks.hpp). Empty: every mapping cloud
-  /// between its keyframe's kid±N keyframes (a dataset made by hand).
+  /// sequence (the keyframes of its window that isTargetCloud() names, target_window_picks.hpp). Empty:
+  /// every mapping cloud between its keyframe's kid±N keyframes (a dataset made by hand).
   std::vector<std::size_t> window;
 };
 

@@ -1,7 +1,8 @@
 #pragma once
 // The target side of a lidar-lidar registration: the mapping lidar's "augmented" cloud around a selected
-// keyframe. Every stored mapping frame between keyframes kid−N and kid+N (N = dense_pointcloud_num_keyframes)
-// is expressed in the mapping-lidar frame interpolated at the calibration scan's stamp, voxelised at
+// keyframe. The mapping clouds of its window, keyframes kid−N to kid+N (N = dense_pointcloud_num_keyframes;
+// which of them: pipeline/target_window_picks.hpp), are
+// expressed in the mapping-lidar frame interpolated at the calibration scan's stamp, voxelised at
 // leaf_size_dense_map and cropped to the source's bounding box (under the initial extrinsic) widened by
 // |t_initial|, then built once into a registration Target (tree, covariances, NDT grid).
 #include <cstddef>
@@ -21,9 +22,9 @@ namespace rigcal::calib {
 struct AugmentedTargetOptions {
   /// At most this many mapping clouds per target, evenly spread over the window (always keeping the
   /// keyframe's own): a stored frame every few centimetres of path gives ~150 clouds per window, most
-  /// of them redundant after voxelising; 0 = all. The pipeline hands over only the
-  /// pipeline::kTargetWindowClouds a frame's target takes (CalibrationFrame::window): more than that
-  /// picks nothing more, fewer spreads over those.
+  /// of them redundant after voxelising; 0 = all. The pipeline hands over only the (at most
+  /// pipeline::kTargetWindowClouds) keyframes' clouds a frame's target takes (CalibrationFrame::window):
+  /// more than that picks nothing more, fewer spreads over those.
   std::size_t max_clouds = pipeline::kTargetWindowClouds;
   double ndt_resolution = 1.0;  // the ensemble's NDT grid
   int num_threads = 1;
