@@ -213,7 +213,7 @@ struct Mapper::Impl {
     return s;
   }
 
-  /// Update: a stored frame keeps its deskewed scan; a keyframe feeds the local map. A lost keyframe
+  /// Update: a keyframe keeps its deskewed scan (for its dense cloud) and feeds the local map. A lost keyframe
   /// restarts the local map (upstream); a failed registration does not feed it, unless registrations keep
   /// failing (the map was restarted from a partial sweep, or the vehicle got far off the prediction):
   /// then the map restarts from this frame at its predicted pose.
@@ -228,8 +228,9 @@ struct Mapper::Impl {
       failures_in_a_row = 0;
     }
     std::shared_ptr<const Scan> shared_deskewed;
-    if (out.frame.stored() || feed) shared_deskewed = std::make_shared<const Scan>(std::move(placed.deskewed));
-    if (out.frame.stored()) out.deskewed = shared_deskewed;
+    // Only keyframes get a dense cloud: targets and the live view read no other (target_window_picks.hpp).
+    if (out.frame.isKeyframe() || feed) shared_deskewed = std::make_shared<const Scan>(std::move(placed.deskewed));
+    if (out.frame.isKeyframe()) out.deskewed = shared_deskewed;
     if (feed) pending_keyframe = PendingKeyframe{shared_deskewed, placed.T_map_lidar, restart};
   }
 

@@ -107,9 +107,7 @@ void Pipeline::Impl::mapperStage() {
       std::lock_guard lock(store_mutex);
       if (f.isKeyframe()) stored_keyframes.push_back(stored_frames.size());
       stored_frames.push_back(f);
-      // Targets are built from keyframes' clouds only (target_window_picks.hpp): an ordinary stored
-      // frame's would never be read again.
-      stored_clouds.push_back(f.isKeyframe() ? out.cloud : nullptr);
+      stored_clouds.push_back(out.cloud);  // a keyframe's; null for the others (MapperOutput::cloud)
     }
     if (f.isKeyframe()) keyframes.fetch_add(1);
     if (f.kind == FrameKind::kStopped || f.kind == FrameKind::kStoppedKeyframe) stopped.fetch_add(1);

@@ -32,11 +32,11 @@ struct MapperOutput {
   std::string skipped_reason;  // too few points, mapper full
   MappingFrame frame;
   RegistrationSummary registration;
-  /// Stored frames only: the deskewed cloud in the lidar frame at frame.stamp_ns, voxelised at
+  /// Keyframes only: the deskewed cloud in the lidar frame at frame.stamp_ns, voxelised at
   /// leaf_size_dense_map: positions only (x, y, z; the other arrays are empty: never point(), filter()). With
   /// Mapper::deferPostPoseWork() left empty until Mapper::finishFrame().
   std::shared_ptr<const Scan> cloud;
-  /// Stored frames, deferred post-pose work only: the deskewed scan `cloud` is made from.
+  /// Keyframes, deferred post-pose work only: the deskewed scan `cloud` is made from.
   std::shared_ptr<const Scan> deskewed;
 };
 
@@ -55,7 +55,7 @@ class Mapper {
 
   /// `scan` as decoded (cropRange to mapping_min/max_range is the mapper's first step).
   MapperOutput process(Scan scan);
-  /// With `defer`, process() stops once the pose is known: the stored frame's dense cloud (voxelised from
+  /// With `defer`, process() stops once the pose is known: a keyframe's dense cloud (voxelised from
   /// `deskewed`) and feeding a keyframe to the local map (milliseconds) are left to finishFrame(), which
   /// the caller runs after publishing the pose (the next process() runs it if the caller did not).
   void deferPostPoseWork(bool defer);
