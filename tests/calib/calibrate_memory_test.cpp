@@ -4,7 +4,8 @@
 // Measured on the 12 s parking-lot drive below (Release, 2 shared cores at load ~15): 440 MB before
 // issue #18's fixes (the deskew stage held every calibration scan to the end of input), 320 MB after.
 // Then (load 4-9): 287-303 MB with targets that kept 4x4 covariances, 231-240 MB with compact ones; 238 MB
-// before targets were built from keyframes' clouds only (shared by neighbouring candidates), 199 MB since.
+// before targets were built from keyframes' clouds only (shared by neighbouring candidates), 199 MB since
+// (192-215 MB at load 6-8).
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -55,14 +56,15 @@ ChildUsage runMeasured(const std::vector<std::string>& args, const std::filesyst
 }
 
 // A 12 s drive of the demo's scenario (two VLP-16 calibration lidars, a 64-beam mapping lidar): its peak
-// RSS stays under a bound the code before keyframe-only target clouds exceeded (238 MB measured) and the
-// code since meets (199 MB). Release only: sanitizers and debug builds allocate differently.
+// RSS stays under a bound the code before keyframe-only target clouds exceeded (238 MB measured, quiet) and
+// the code since meets (199 MB quiet, up to 215 MB at load 8). Release only: sanitizers and debug builds
+// allocate differently.
 TEST(CalibrateMemory, PeakRssOfAShortDriveStaysBounded) {
 #ifndef NDEBUG
   GTEST_SKIP() << "peak memory is asserted in optimised builds only";
 #endif
   if (kSanitized) GTEST_SKIP() << "peak memory is asserted in uninstrumented builds only";
-  constexpr long kBoundKb = 225 * 1024;
+  constexpr long kBoundKb = 235 * 1024;
   TempDir dir;
   const auto sim = dir / "sim";
   const auto simulated =
