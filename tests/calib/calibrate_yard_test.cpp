@@ -122,7 +122,8 @@ Calibrated calibrate(const std::string& preset, const std::vector<std::string>& 
 
 class CalibrateYardLong : public ::testing::TestWithParam<const char*> {};
 
-// Never a wrong `ok`, whatever the load: ok → within the goal; otherwise unverified with a suggested deadline.
+// Never a wrong `ok`, whatever the load: ok → within the goal; otherwise unverified, saying what would confirm
+// it (the --deadline, or more frames).
 TEST_P(CalibrateYardLong, UnderTheDefaultDeadlineOkMeansWithinTheGoal) {
   if (!longTests()) GTEST_SKIP() << "long test: set RIGCAL_LONG_TESTS=1 (Release only)";
   TempDir dir;
@@ -140,7 +141,11 @@ TEST_P(CalibrateYardLong, UnderTheDefaultDeadlineOkMeansWithinTheGoal) {
       EXPECT_LT(e.deg, 0.05) << sensor << " is called ok off the goal";
     } else {
       EXPECT_EQ(l.value("verdict", ""), "unverified") << sensor;
-      EXPECT_GT(l["evidence"].value("suggested_deadline_s", 0.0), 0.0) << sensor << ": say which --deadline would do";
+      // What would confirm it: a --deadline when the deadline cut the plan short of evidence; otherwise (every
+      // frame registered, side_right's scatter of ± 0.068 deg over its 4 frames) more frames.
+      const bool more_time = l["evidence"].value("suggested_deadline_s", 0.0) > 0.0;
+      const bool more_frames = l.value("doubt", "").find("more frames would narrow it") != std::string::npos;
+      EXPECT_TRUE(more_time || more_frames) << sensor << ": say what would confirm it: " << l.value("doubt", "");
     }
   }
   EXPECT_EQ(c.exit_code, all_ok ? 0 : 6) << "exit 6 (unverified) unless every lidar is ok";
