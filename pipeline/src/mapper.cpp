@@ -213,10 +213,10 @@ struct Mapper::Impl {
     return s;
   }
 
-  /// Update: a keyframe keeps its deskewed scan (for its dense cloud) and feeds the local map. A lost keyframe
-  /// restarts the local map (upstream); a failed registration does not feed it, unless registrations keep
-  /// failing (the map was restarted from a partial sweep, or the vehicle got far off the prediction):
-  /// then the map restarts from this frame at its predicted pose.
+  /// Update: a keyframe keeps its deskewed scan (for its dense cloud) and feeds the local map. A lost
+  /// keyframe restarts the local map (upstream); a failed registration does not feed it, unless
+  /// registrations keep failing (the map was restarted from a partial sweep, or the vehicle got far off the
+  /// prediction): then the map restarts from this frame at its predicted pose.
   void keep(MapperOutput& out, Placement&& placed) {
     failures_in_a_row = out.registration.ok ? 0 : failures_in_a_row + 1;
     bool feed = false, restart = false;

@@ -143,7 +143,8 @@ struct Pipeline::Impl {
   std::vector<MappingFrame> trajectory;
   mutable std::mutex store_mutex;
   std::vector<MappingFrame> stored_frames;
-  std::vector<std::shared_ptr<const Scan>> stored_clouds;  // keyframes' clouds; nullptr once released and for other frames
+  // Each stored frame's cloud: a keyframe's, nullptr for the others and once released.
+  std::vector<std::shared_ptr<const Scan>> stored_clouds;
   std::vector<std::size_t> stored_keyframes;
 
   // Results of the selector.

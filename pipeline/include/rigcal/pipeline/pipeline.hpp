@@ -102,8 +102,8 @@ struct MappingResult {
   std::vector<MappingFrame> trajectory;       // every registered frame (stored, stopped, dropped, lost), in order
   /// The whole map in the map frame (= the first mapping-lidar frame), voxelised at leaf_size_local_map.
   std::shared_ptr<const Scan> map_cloud;
-  /// Only when asked for (Pipeline::mapping(true): it costs seconds on a long run): the keyframes' clouds
-  /// (the ones targets are built from) of the last dense_pointcloud_num_keyframes keyframes, in the map frame, voxelised at
+  /// Only when asked for (Pipeline::mapping(true): it costs seconds on a long run): the clouds of the last
+  /// dense_pointcloud_num_keyframes keyframes (only keyframes have one), in the map frame, voxelised at
   /// leaf_size_dense_map. Empty while no keyframe exists; nullptr when not asked for.
   std::shared_ptr<const Scan> dense_cloud;
   int last_keyframe_frame = -1;  // index into `trajectory` of the keyframe `dense_cloud` is centred on

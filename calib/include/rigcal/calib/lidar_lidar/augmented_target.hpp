@@ -1,10 +1,10 @@
 #pragma once
 // The target side of a lidar-lidar registration: the mapping lidar's "augmented" cloud around a selected
 // keyframe. The mapping clouds of its window, keyframes kid−N to kid+N (N = dense_pointcloud_num_keyframes;
-// which of them: pipeline/target_window_picks.hpp), are
-// expressed in the mapping-lidar frame interpolated at the calibration scan's stamp, voxelised at
-// leaf_size_dense_map and cropped to the source's bounding box (under the initial extrinsic) widened by
-// |t_initial|, then built once into a registration Target (tree, covariances, NDT grid).
+// which of them: pipeline/target_window_picks.hpp), are expressed in the mapping-lidar frame interpolated
+// at the calibration scan's stamp, voxelised at leaf_size_dense_map and cropped to the source's bounding box
+// (under the initial extrinsic) widened by |t_initial|, then built once into a registration Target (tree,
+// covariances, NDT grid).
 #include <cstddef>
 #include <memory>
 #include <optional>
