@@ -1,8 +1,7 @@
 // The lidar-lidar ensemble on simulator data (parking-lot, a 10 s stretch, 4 frames, guess 0.3 m / 5° off):
 // time per registrator on one frame (our NDT / GICP / ICP coarse, fine, ultra-fine against PCL 1.13's NDT,
 // GICP and ICP with upstream's settings, the baseline upstream runs), the augmented-target build (the first
-// frame's box crop, a later frame's near crop, and the crop alone; every later frame's own target against one
-// shared target), the all-frames score, batched ICP, and
+// frame's box crop, a later frame's near crop, and the crop alone), the all-frames score, batched ICP, and
 // a whole calibrateLidarLidar run under the default 10 s deadline (without one, the exhaustive pass runs
 // every registrator from every candidate: ~870 registrations).
 // Run pinned: taskset -c 0,1 calibration_bench --benchmark_repetitions=10 (median and p99 are reported).
@@ -27,7 +26,6 @@
 #include "rigcal/calib/lidar_lidar/calibration_source.hpp"
 #include "rigcal/calib/lidar_lidar/ensemble_plan.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
-#include "rigcal/calib/lidar_lidar/shared_target_cloud.hpp"
 
 namespace {
 
@@ -153,75 +151,6 @@ void targetCrop(benchmark::State& state) {
   state.counters["target_points"] = double(points);
 }
 
-// Every later frame's target (frames 1..n-1, near crops under the guess and the truth): each frame's own, as
-// the calibrator built them before, against one shared map-frame target (SharedTargetCloud) read through each
-// frame's anchor, as it builds them now.
-void laterTargets(benchmark::State& state, bool shared) {
-  const auto& f = fixture();
-  const auto& d = f.data.datasets.front();
-  const std::vector<Pose> poses{d.T_mapping_calib_guess, f.truth};
-  const double radius = calib::nearTargetRadius(f.data.params);
-  std::size_t points = 0;
-  for (auto _ : state) {
-    points = 0;
-    if (shared) {
-      calib::SharedTargetCloud cloud(d, f.data.params);
-      for (std::size_t i = 1; i < d.frames.size(); ++i) cloud.add(i, f.sources[i], poses, radius, {});
-      registration::TargetOptions o;
-      o.normals_and_covariances = true;
-      o.ndt_resolutions = {1.0};
-      o.num_threads = int(state.range(0));
-      points = registration::Target(cloud.cloud(), o).size();
-    } else {
-      calib::AugmentedTargetOptions to;
-      to.num_threads = int(state.range(0));
-      to.near_poses = poses;
-      to.near_radius = radius;
-      for (std::size_t i = 1; i < d.frames.size(); ++i)
-        points += calib::buildAugmentedTarget(d, i, f.sources[i], f.data.params, to).target->size();
-    }
-  }
-  state.counters["target_points"] = double(points);
-}
-
-// What reading the shared target costs the registrations: the later frames' ensembles (every registrator from
-// the guess) against each frame's own near target, or against the one shared target through the anchors.
-void laterEnsembles(benchmark::State& state, bool shared) {
-  const auto& f = fixture();
-  const auto& d = f.data.datasets.front();
-  const std::vector<Pose> poses{d.T_mapping_calib_guess, f.truth};
-  const double radius = calib::nearTargetRadius(f.data.params);
-  registration::TargetOptions o;
-  o.normals_and_covariances = true;
-  o.ndt_resolutions = {1.0};
-  o.num_threads = 2;
-  std::vector<registration::SourceTarget> pairs;
-  std::vector<std::shared_ptr<const registration::Target>> targets;
-  calib::SharedTargetCloud cloud(d, f.data.params);
-  for (std::size_t i = 1; i < d.frames.size(); ++i) cloud.add(i, f.sources[i], poses, radius, {});
-  if (shared) targets.push_back(std::make_shared<const registration::Target>(cloud.cloud(), o));
-  for (std::size_t i = 1; i < d.frames.size(); ++i) {
-    if (!shared) {
-      calib::AugmentedTargetOptions to;
-      to.num_threads = 2;
-      to.near_poses = poses;
-      to.near_radius = radius;
-      targets.push_back(calib::buildAugmentedTarget(d, i, f.sources[i], f.data.params, to).target);
-    }
-    pairs.push_back({&f.sources[i], targets.back().get(), shared ? cloud.anchor(i) : Pose::Identity()});
-  }
-  int iterations = 0;
-  for (auto _ : state) {
-    iterations = 0;
-    for (const auto& pair : pairs)
-      for (const auto r : calib::perFrameRegistrators())
-        iterations += calib::runRegistrator(r, pair, d.T_mapping_calib_guess, f.data.params, int(state.range(0)),
-                                            registration::Deadline::never())
-                          .iterations;
-  }
-  state.counters["iterations"] = iterations;
-}
-
 void scoreAll(benchmark::State& state) {
   const auto& f = fixture();
   std::vector<registration::SourceTarget> pairs;
@@ -320,16 +249,6 @@ int main(int argc, char** argv) {
   add(benchmark::RegisterBenchmark("ours/target_build", targetBuild)->Arg(1)->Arg(2));
   add(benchmark::RegisterBenchmark("ours/target_build_near", targetBuildNear)->Arg(1)->Arg(2));
   add(benchmark::RegisterBenchmark("ours/target_crop", targetCrop)->ArgName("near")->Arg(0)->Arg(1));
-  add(benchmark::RegisterBenchmark("ours/later_targets_per_frame", [](benchmark::State& s) { laterTargets(s, false); })
-          ->Arg(1)
-          ->Arg(2));
-  add(benchmark::RegisterBenchmark("ours/later_targets_shared", [](benchmark::State& s) { laterTargets(s, true); })
-          ->Arg(1)
-          ->Arg(2));
-  add(benchmark::RegisterBenchmark("ours/later_ensembles_own", [](benchmark::State& s) { laterEnsembles(s, false); })
-          ->Arg(1));
-  add(benchmark::RegisterBenchmark("ours/later_ensembles_shared", [](benchmark::State& s) { laterEnsembles(s, true); })
-          ->Arg(1));
   add(benchmark::RegisterBenchmark("ours/score_all_frames", scoreAll)->Arg(1)->Arg(2));
   add(benchmark::RegisterBenchmark("ours/batched_icp_chain", batched)->Arg(1)->Arg(2));
   add(benchmark::RegisterBenchmark("ours/calibrate_whole_run", wholeRun)->Arg(1)->Arg(2)->Iterations(1));

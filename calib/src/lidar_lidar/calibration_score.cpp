@@ -21,12 +21,7 @@ CalibrationScore fromEvaluation(const registration::Evaluation& e) {
 
 CalibrationScore scoreFrame(const registration::Target& target, const registration::PointCloud& source,
                             const Pose& T_mapping_calib, double max_distance, int num_threads) {
-  return scoreFrame({&source, &target}, T_mapping_calib, max_distance, num_threads);
-}
-
-CalibrationScore scoreFrame(const registration::SourceTarget& frame, const Pose& T_mapping_calib, double max_distance,
-                            int num_threads) {
-  return fromEvaluation(registration::evaluate({&frame, 1}, T_mapping_calib, max_distance, num_threads));
+  return fromEvaluation(registration::evaluate(target, source, T_mapping_calib, max_distance, num_threads));
 }
 
 CalibrationScore scoreAllFrames(const std::vector<registration::SourceTarget>& frames, const Pose& T_mapping_calib,
@@ -39,7 +34,7 @@ CalibrationScore scoreAllFrames(const std::vector<registration::SourceTarget>& f
     const auto& pts = frames[f].source->points;
     thinned[f].points.reserve(pts.size() / stride + 1);
     for (std::size_t i = 0; i < pts.size(); i += stride) thinned[f].points.push_back(pts[i]);
-    pairs[f] = {&thinned[f], frames[f].target, frames[f].anchor};
+    pairs[f] = {&thinned[f], frames[f].target};
   }
   return fromEvaluation(registration::evaluate(pairs, T_mapping_calib, max_distance, num_threads));
 }

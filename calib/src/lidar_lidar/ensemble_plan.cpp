@@ -45,12 +45,6 @@ registration::RegistrationResult runRegistrator(Registrator r, const registratio
                                                 const registration::PointCloud& source, const Pose& guess,
                                                 const config::Parameters& params, int num_threads,
                                                 const registration::Deadline& deadline) {
-  return runRegistrator(r, registration::SourceTarget{&source, &target}, guess, params, num_threads, deadline);
-}
-
-registration::RegistrationResult runRegistrator(Registrator r, const registration::SourceTarget& frame,
-                                                const Pose& guess, const config::Parameters& params, int num_threads,
-                                                const registration::Deadline& deadline) {
   switch (r) {
     case Registrator::kNdt: {
       registration::NdtParams p;
@@ -61,13 +55,13 @@ registration::RegistrationResult runRegistrator(Registrator r, const registratio
       p.transformation_epsilon = 1e-3;  // NDT's optimum is only as sharp as its 1 m voxels; ICP refines
       p.rotation_epsilon = 1e-4;
       p.max_correspondence_distance = params.max_corr_dist_coarse;
-      return registration::alignNdt(frame, guess, p, deadline);
+      return registration::alignNdt(target, source, guess, p, deadline);
     }
     case Registrator::kGicp: {
       registration::GicpParams p;
       common(p, params, num_threads);
       p.max_correspondence_distance = params.max_corr_dist_coarse;
-      return registration::alignGicp(frame, guess, p, deadline);
+      return registration::alignGicp(target, source, guess, p, deadline);
     }
     case Registrator::kIcpCoarse:
     case Registrator::kIcpFine:
@@ -79,7 +73,7 @@ registration::RegistrationResult runRegistrator(Registrator r, const registratio
       p.max_correspondence_distance = r == Registrator::kIcpCoarse ? params.max_corr_dist_coarse
                                       : r == Registrator::kIcpFine ? params.max_corr_dist_fine
                                                                    : params.max_corr_dist_ultra_fine;
-      return registration::alignIcp(frame, guess, p, deadline);
+      return registration::alignIcp(target, source, guess, p, deadline);
     }
   }
   return {};

@@ -23,7 +23,7 @@ TrajectoryClockEstimate trajectoryClock(const pipeline::CalibrationDataset& data
                                         const LidarLidarOptions& options) {
   std::vector<TrajectoryClockFrame> frames;
   for (const auto& f : calibrator.frames())
-    frames.push_back({&f.source, f.target.get(), dataset.frames[f.index].pairing.scan_stamp_ns, f.anchor});
+    frames.push_back({&f.source, f.target.get(), dataset.frames[f.index].pairing.scan_stamp_ns});
   try {
     return estimateTrajectoryClockOffset(frames, dataset.trajectory, result.T_mapping_calib, deadline,
                                          options.trajectory_clock_options);
@@ -43,8 +43,7 @@ void frameInformation(const detail::Calibrator& calibrator, const config::Parame
   for (const auto& f : calibrator.frames()) total += f.source.size();
   const std::size_t stride = std::max<std::size_t>(1, (total + max_points - 1) / max_points);
   for (const auto& f : calibrator.frames())
-    // In the calibration lidar's own frame: the same under the frame's anchor as in its target's frame.
-    out.frame_information[int(f.index)] = framePoseInformation(*f.target, f.source, f.anchor * out.T_mapping_calib,
+    out.frame_information[int(f.index)] = framePoseInformation(*f.target, f.source, out.T_mapping_calib,
                                                                params.calibration_eval_max_corr_distance, stride);
 }
 

@@ -63,6 +63,34 @@ bool Calibrator::firstFrame(std::size_t& next) {
   return true;
 }
 
+bool Calibrator::laterTargets(std::size_t& next, std::size_t first_frames) {
+  // Every other frame, scored together from now on.
+  auto t = Clock::now();
+  bool targets_cut = false;
+  while (next < data_.frames.size() && !targets_cut) {
+    // After a frame's target, time for what makes one estimate of the frames: the grown set's rescore (else
+    // the new frames are dropped) and the batched chain. Without that reserve a loaded machine spent the
+    // whole share on targets and never ran the batched ICP (parking lot at load 7: front_right 1.0-1.3 cm
+    // off). The source and crop must fit as long as the last ones took; whether the target build fits is
+    // judged on the cropped cloud (buildFrame).
+    const double grown_next = double(frames_.size() + 1) / double(first_frames);
+    const double reserve = 2.5 * grown_next * score_seconds_ + batchedChainEstimate(frames_.size() + 1);
+    const std::size_t built = frames_.size();
+    targets_cut = !fits(deadline_, 1.2 * last_prepare_seconds_ + reserve) ||
+                  buildFrame(next++, reserve) == FrameBuild::kOutOfTime;
+    if (targets_cut) break;
+    seconds_.targets += since(t);
+    // Its own view of the best at once (one ICP), before the next target: if the deadline cuts the
+    // targets, the frames built so far still count as evidence for the verdict (lidar_lidar_verdict.hpp).
+    t = Clock::now();
+    if (frames_.size() > built && !stopped()) confirmOnFrame(frames_.size() - 1);
+    seconds_.ensemble += since(t);
+    t = Clock::now();
+  }
+  seconds_.targets += since(t);
+  return targets_cut;
+}
+
 bool Calibrator::restOfPlan(std::size_t first_frames) {
   // A next target that did not fit ends the targets, not the plan: the frames built so far still get the
   // rescore, the batched chain and their ensembles in the time left (it had skipped all of them: under load
@@ -140,13 +168,13 @@ void Calibrator::rescore() {
 
 void Calibrator::rebuildScorePairs() {
   std::vector<SourceTarget> full;
-  for (auto& f : frames_) full.push_back(f.pair());
+  for (auto& f : frames_) full.push_back({&f.source, f.target.get()});
   const std::size_t stride = scoreStride(full, opt_.score_points);
   score_pairs_.clear();
   for (auto& f : frames_) {
     f.score_source.points.clear();
     for (std::size_t i = 0; i < f.source.size(); i += stride) f.score_source.points.push_back(f.source.points[i]);
-    score_pairs_.push_back(f.scorePair());
+    score_pairs_.push_back({&f.score_source, f.target.get()});
   }
 }
 

@@ -35,13 +35,7 @@ struct Frame {
   std::size_t index = 0;  // in the dataset
   PointCloud source;        // covariances only once a GICP ran on the frame (ensureSourceCovariances)
   PointCloud score_source;  // every stride-th point: what the all-frames score looks at
-  /// Its own augmented target (in the mapping frame at its scan: anchor = identity), or the one the later
-  /// frames share (in the map frame: anchor = T_map_mapping_at_scan).
   std::shared_ptr<const Target> target;
-  Pose anchor = Pose::Identity();
-
-  [[nodiscard]] SourceTarget pair() const { return {&source, target.get(), anchor}; }
-  [[nodiscard]] SourceTarget scorePair() const { return {&score_source, target.get(), anchor}; }
 };
 
 /// What building a frame came to: the frame, a frame skipped for want of points, or no time to build it.
@@ -69,8 +63,8 @@ class Calibrator {
   /// The first dataset frame that builds, and its ensemble; `next` moves past the frames tried. False (with
   /// out_.failure) when no frame could be built.
   bool firstFrame(std::size_t& next);
-  /// The other frames, as many as leave time for the rescore and the batched chain, with one target they share
-  /// (SharedTargetCloud), each then confirmed by one ICP; true when the deadline cut them.
+  /// The other frames' targets, each confirmed by one ICP, while each leaves time for the rescore and the
+  /// batched chain; true when the deadline cut them.
   bool laterTargets(std::size_t& next, std::size_t first_frames);
   /// The grown set's rescore, the batched chain, the re-deskew, then the other frames' ensembles; true when
   /// all of it ran.
@@ -82,14 +76,10 @@ class Calibrator {
   /// call (out_.deadline_reached): the exhaustive pass at the end only fills the time left.
   [[nodiscard]] bool stopped() const;
 
-  /// Source and own augmented target of dataset frame i (the first frame); a frame without enough points
-  /// is skipped (noted).
-  FrameBuild buildFrame(std::size_t i);
-  FrameBuild buildFrameTarget(std::size_t i);  // buildFrame's work, before the clouds' release
-  /// Frame i's source into f; skipped (noted) when it has too few points.
-  FrameBuild prepareSource(std::size_t i, Frame& f);
-  /// A Target with what the registrators need (measures seconds_per_point_); nullptr when the deadline cut it.
-  std::shared_ptr<const Target> buildTarget(PointCloud cloud, double ndt_resolution);
+  /// Source and augmented target of dataset frame i; a frame without enough points is skipped (noted).
+  /// Out of time when the target's build would leave less than `reserve` seconds.
+  FrameBuild buildFrame(std::size_t i, double reserve = 0.0);
+  FrameBuild buildFrameTarget(std::size_t i, double reserve);  // buildFrame's work, before the clouds' release
 
   /// The initial guess's and the best's scores over the frames built so far (the set just grew).
   void rescore();

@@ -17,7 +17,7 @@ void Calibrator::frameEnsemble(std::size_t k, bool exhaustive) {
   const Frame& f = frames_[k];
   const double d_eval = params_.calibration_eval_max_corr_distance;
   std::size_t frame_best = addCandidate(best_);
-  double frame_best_score = scoreFrame(f.pair(), out_.candidates[frame_best], d_eval, opt_.num_threads).value;
+  double frame_best_score = scoreFrame(*f.target, f.source, out_.candidates[frame_best], d_eval, opt_.num_threads).value;
   for (const Registrator r : perFrameRegistrators()) {
     std::vector<std::size_t> starts;
     if (exhaustive) {
@@ -37,7 +37,7 @@ void Calibrator::frameEnsemble(std::size_t k, bool exhaustive) {
       run.start = start;
       run.redeskewed = redeskewed_;
       const auto tr = Clock::now();
-      const auto res = runRegistrator(r, f.pair(), out_.candidates[start], params_, opt_.num_threads,
+      const auto res = runRegistrator(r, *f.target, f.source, out_.candidates[start], params_, opt_.num_threads,
                                       registrationDeadline());
       run.seconds = since(tr);
       run.iterations = res.iterations;
@@ -45,7 +45,7 @@ void Calibrator::frameEnsemble(std::size_t k, bool exhaustive) {
       if (res.status != registration::Status::kInvalidInput &&
           res.status != registration::Status::kTooFewCorrespondences && finitePose(res.T_target_source) &&
           fits(deadline_, score_seconds_ / 2)) {
-        run.frame_score = scoreFrame(f.pair(), res.T_target_source, d_eval, opt_.num_threads).value;
+        run.frame_score = scoreFrame(*f.target, f.source, res.T_target_source, d_eval, opt_.num_threads).value;
         const std::size_t id = addCandidate(res.T_target_source);
         run.result = id;
         if (run.frame_score < reg_best_score) {
@@ -93,13 +93,13 @@ void Calibrator::confirmOnFrame(std::size_t k) {
   run.redeskewed = redeskewed_;
   if (!tried_.insert({f.index, int(r), run.start, redeskewed_}).second) return;
   const auto tr = Clock::now();
-  const auto res = runRegistrator(r, f.pair(), best_, params_, opt_.num_threads, registrationDeadline());
+  const auto res = runRegistrator(r, *f.target, f.source, best_, params_, opt_.num_threads, registrationDeadline());
   run.seconds = since(tr);
   run.iterations = res.iterations;
   run.status = std::string(registration::toString(res.status));
   if (res.status != registration::Status::kInvalidInput && res.status != registration::Status::kTooFewCorrespondences &&
       finitePose(res.T_target_source) && fits(deadline_, score_seconds_ / 2)) {
-    run.frame_score = scoreFrame(f.pair(), res.T_target_source, params_.calibration_eval_max_corr_distance,
+    run.frame_score = scoreFrame(*f.target, f.source, res.T_target_source, params_.calibration_eval_max_corr_distance,
                                  opt_.num_threads)
                           .value;
     run.result = addCandidate(res.T_target_source);
@@ -109,7 +109,7 @@ void Calibrator::confirmOnFrame(std::size_t k) {
 
 void Calibrator::batchedChain(const Pose& start) {
   std::vector<SourceTarget> pairs;
-  for (auto& f : frames_) pairs.push_back(f.pair());
+  for (auto& f : frames_) pairs.push_back({&f.source, f.target.get()});
   Pose T = start;
   for (const double d : batchedDistances(params_)) {
     if (stopped()) return;

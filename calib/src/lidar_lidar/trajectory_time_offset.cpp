@@ -23,8 +23,7 @@ struct FrameData {
   const registration::Target* target = nullptr;
   std::vector<Eigen::Vector4d> points;  // every k-th source point
   std::vector<std::uint32_t> hints;     // last match per point: speeds the next search up
-  Pose T_at_stamp_inv = Pose::Identity();  // mapping pose at the stamp, inverted
-  Pose anchor = Pose::Identity();          // the mapping frame at the stamp in the target's frame
+  Pose T_at_stamp_inv = Pose::Identity();  // mapping pose at the stamp, inverted (the target's frame)
   TimeNs stamp_ns = 0;
 };
 
@@ -42,7 +41,7 @@ Pass linearise(std::vector<FrameData>& frames, const std::vector<Pose>& D, const
   const double c2 = max_distance * max_distance;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     FrameData& f = frames[k];
-    const Pose A = f.anchor * D[k] * T;
+    const Pose A = D[k] * T;
     const Eigen::Matrix3d At = A.linear().transpose();
     const auto& cloud = f.target->cloud();
     for (std::size_t i = 0; i < f.points.size(); ++i) {
@@ -164,7 +163,6 @@ TrajectoryClockEstimate estimateTrajectoryClockOffset(const std::vector<Trajecto
     if (f.source == nullptr || f.target == nullptr || !f.target->hasNormals() || f.target->empty()) continue;
     FrameData d;
     d.target = f.target;
-    d.anchor = f.anchor;
     d.stamp_ns = f.stamp_ns;
     d.T_at_stamp_inv = mappingPoseAt(trajectory, f.stamp_ns).inverse();
     for (std::size_t i = 0; i < f.source->size(); i += stride) d.points.push_back(f.source->points[i]);

@@ -25,9 +25,6 @@ struct CalibrationScore {
 /// One frame's score (all of its source points).
 CalibrationScore scoreFrame(const registration::Target& target, const registration::PointCloud& source,
                             const Pose& T_mapping_calib, double max_distance, int num_threads = 1);
-/// The same for a frame whose target is kept in another frame (SourceTarget::anchor).
-CalibrationScore scoreFrame(const registration::SourceTarget& frame, const Pose& T_mapping_calib, double max_distance,
-                            int num_threads = 1);
 
 /// The score over all frames, each frame's points weighted equally (so a frame counts by its size).
 /// `stride` > 1 scores every stride-th point of each source (deterministic), to bound its cost.

@@ -37,11 +37,6 @@ registration::RegistrationResult runRegistrator(Registrator r, const registratio
                                                 const registration::PointCloud& source, const Pose& guess,
                                                 const config::Parameters& params, int num_threads,
                                                 const registration::Deadline& deadline);
-/// The same for a frame whose target is kept in another frame (SourceTarget::anchor): the result is still
-/// T_mapping_calib.
-registration::RegistrationResult runRegistrator(Registrator r, const registration::SourceTarget& frame,
-                                                const Pose& guess, const config::Parameters& params, int num_threads,
-                                                const registration::Deadline& deadline);
 
 /// One batched point-to-plane ICP pass over all frames at `max_distance`.
 registration::RegistrationResult runBatched(const std::vector<registration::SourceTarget>& frames, const Pose& guess,

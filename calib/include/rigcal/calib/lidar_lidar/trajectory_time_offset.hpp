@@ -29,7 +29,6 @@ struct TrajectoryClockFrame {
   const registration::PointCloud* source = nullptr;
   const registration::Target* target = nullptr;
   TimeNs stamp_ns = 0;
-  Pose anchor = Pose::Identity();  // the frame's mapping pose in its target's frame (SourceTarget::anchor)
 };
 
 struct TrajectoryClockOptions {
