@@ -19,10 +19,6 @@ CorrespondenceObjective::CorrespondenceObjective(std::span<const SourceTarget> p
                                                  double max_distance, int num_threads)
     : pairs_(pairs), kind_(kind), max_sq_(max_distance * max_distance), num_threads_(num_threads) {
   chunks_ = makeChunks(pairs, kChunkSize);
-  for (const auto& p : pairs) {
-    anchors_.push_back(p.anchor.matrix());
-    anchored_.push_back(!p.anchor.matrix().isIdentity(0.0) ? 1 : 0);
-  }
   std::size_t total = 0;
   for (const auto& p : pairs) total += p.source->size();
   // Every per-point array below is in each source's spatial order, and so are the chunks: a chunk's
@@ -204,9 +200,8 @@ double CorrespondenceObjective::costTerm(std::size_t g, const Eigen::Vector3d& r
 
 template <Residual K, bool kPrevious>
 CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const PairChunk& chunk,
-                                                                      const Eigen::Matrix4d& shared) {
+                                                                      const Eigen::Matrix4d& M) {
   const Target& target = *pairs_[chunk.pair].target;
-  const Eigen::Matrix4d M = chunkPose(chunk, shared);
   const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();
   Pass out;
   LinearSystem& sys = out.sys;
@@ -258,14 +253,12 @@ CorrespondenceObjective::Pass CorrespondenceObjective::linearizeChunk(const Pair
   if constexpr (K == Residual::kPointToPoint) p2p.finish(sys.H);
   if constexpr (K == Residual::kGicp) gicp.finish(sys);
   mirrorUpper(sys.H);
-  if (anchored_[chunk.pair]) toSharedTwist(anchors_[chunk.pair], sys.H, sys.b);
   return out;
 }
 
 template <Residual K>
-double CorrespondenceObjective::costChunk(const PairChunk& chunk, const Eigen::Matrix4d& shared) const {
+double CorrespondenceObjective::costChunk(const PairChunk& chunk, const Eigen::Matrix4d& M) const {
   const Target& target = *pairs_[chunk.pair].target;
-  const Eigen::Matrix4d M = chunkPose(chunk, shared);
   double cost = 0.0;
   for (std::size_t i = chunk.begin; i < chunk.end; i += stride_) {
     const std::size_t g = chunk.offset + (i - chunk.begin);
@@ -317,7 +310,7 @@ std::optional<LinearSystem> CorrespondenceObjective::linearize(const Pose& T, co
 }
 
 std::optional<LinearSystem> CorrespondenceObjective::measure(const Pose& T, const Deadline& deadline) {
-  const Eigen::Matrix4d shared = T.matrix();
+  const Eigen::Matrix4d M = T.matrix();
   std::atomic<bool> stopped{false};
   LinearSystem sys = parallelReduce(chunks_.size(), num_threads_, LinearSystem{}, [&](std::size_t t) {
     LinearSystem part;
@@ -327,7 +320,6 @@ std::optional<LinearSystem> CorrespondenceObjective::measure(const Pose& T, cons
     }
     const PairChunk& chunk = chunks_[t];
     const Target& target = *pairs_[chunk.pair].target;
-    const Eigen::Matrix4d M = chunkPose(chunk, shared);
     for (std::size_t i = chunk.begin; i < chunk.end; i += stride_) {
       const std::size_t g = chunk.offset + (i - chunk.begin);
       const Eigen::Vector4d q = M * source_points_[g];

@@ -74,14 +74,7 @@ class CorrespondenceObjective final : public Objective {
   // Cube edge of the sources' spatial order (m): a few source voxels, so a run of queries stays local.
   static constexpr double kOrderCell = 0.5;
   static constexpr std::size_t kChunkSize = 512;  // source points per parallel task
-  /// Where chunk's source points land in its target: M, or anchor·M for an anchored pair.
-  [[nodiscard]] Eigen::Matrix4d chunkPose(const PairChunk& chunk, const Eigen::Matrix4d& M) const {
-    return anchored_[chunk.pair] ? Eigen::Matrix4d(anchors_[chunk.pair] * M) : M;
-  }
-
   std::span<const SourceTarget> pairs_;
-  std::vector<Eigen::Matrix4d> anchors_;  // per pair
-  std::vector<char> anchored_;            // per pair: its anchor is not the identity
   Residual kind_;
   double max_sq_;
   int num_threads_;

@@ -27,10 +27,9 @@ double conditioning(std::span<const SourceTarget> pairs, const Pose& T, double m
   std::vector<Eigen::Vector3d> at, normal;
   std::size_t global = 0;
   Neighbor nb[kNormalNeighbors];
-  for (const auto& [source, target, anchor] : pairs) {
-    const Eigen::Matrix4d Mp = anchor.matrix() * M;
+  for (const auto& [source, target] : pairs) {
     for (std::size_t i = (stride - global % stride) % stride; i < source->size(); i += stride) {
-      const Eigen::Vector4d q = Mp * source->points[i];
+      const Eigen::Vector4d q = M * source->points[i];
       Neighbor hit;
       if (!target->tree().nearest(q, max_sq, &hit)) continue;
       const Eigen::Vector3d x = target->cloud().points[hit.index].head<3>();

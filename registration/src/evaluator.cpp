@@ -49,9 +49,8 @@ std::optional<Evaluation> evaluatePairs(std::span<const SourceTarget> pairs, con
     const PairChunk& c = chunks[t];
     const PointCloud& source = *pairs[c.pair].source;
     const Target& target = *pairs[c.pair].target;
-    const Eigen::Matrix4d Mc = pairs[c.pair].anchor.matrix() * M;
     for (std::size_t i = c.begin; i < c.end; ++i) {
-      const Eigen::Vector4d q = Mc * source.points[i];
+      const Eigen::Vector4d q = M * source.points[i];
       Neighbor nb;
       if (!target.tree().nearest(q, max_sq, &nb)) continue;
       const double d2 = (target.cloud().points[nb.index] - q).squaredNorm();

@@ -8,14 +8,8 @@ namespace rigcal::registration {
 
 RegistrationResult alignGicp(const Target& target, const PointCloud& source, const Pose& guess,
                              const GicpParams& params, const Deadline& deadline) {
-  return alignGicp(SourceTarget{&source, &target}, guess, params, deadline);
-}
-
-RegistrationResult alignGicp(SourceTarget pair, const Pose& guess, const GicpParams& params,
-                             const Deadline& deadline) {
   constexpr const char* kName = "GICP";
-  const Target& target = *pair.target;
-  const PointCloud& source = *pair.source;
+  SourceTarget pair{&source, &target};
   std::string bad = detail::validateInputs({&pair, 1}, guess, params, params.max_correspondence_distance);
   if (bad.empty() && !target.hasCovariances()) {
     bad = "target has no covariances (build it with normals_and_covariances)";

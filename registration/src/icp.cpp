@@ -26,11 +26,7 @@ RegistrationResult alignBatchedIcp(std::span<const SourceTarget> pairs, const Po
 
 RegistrationResult alignIcp(const Target& target, const PointCloud& source, const Pose& guess,
                             const IcpParams& params, const Deadline& deadline) {
-  return alignIcp(SourceTarget{&source, &target}, guess, params, deadline);
-}
-
-RegistrationResult alignIcp(const SourceTarget& pair, const Pose& guess, const IcpParams& params,
-                            const Deadline& deadline) {
+  const SourceTarget pair{&source, &target};
   return alignBatchedIcp(std::span<const SourceTarget>(&pair, 1), guess, params, deadline);
 }
 

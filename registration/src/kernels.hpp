@@ -78,21 +78,6 @@ struct PointToPointSums {
 
 inline void mirrorUpper(Matrix6d& H) { H.triangularView<Eigen::StrictlyLower>() = H.transpose(); }
 
-/// A pair with an anchor (SourceTarget::anchor) is linearised in its target's frame, for the left twist δ of
-/// anchor·T; the solver steps the shared T. Since anchor·exp(δ')·T = exp(Ad·δ')·anchor·T with
-/// Ad = [[R, [t]×R], [0, R]] (R, t: the anchor's), the system for δ' is H' = Adᵀ·H·Ad, b' = Adᵀ·b: once per
-/// chunk, not per point. (Complete H, not its upper triangle.)
-inline void toSharedTwist(const Eigen::Matrix4d& anchor, Matrix6d& H, Vector6d& b) {
-  const Eigen::Matrix3d R = anchor.topLeftCorner<3, 3>();
-  const Eigen::Vector3d t = anchor.topRightCorner<3, 1>();
-  Matrix6d Ad = Matrix6d::Zero();
-  Ad.topLeftCorner<3, 3>() = R;
-  Ad.topRightCorner<3, 3>() = skew(t) * R;
-  Ad.bottomRightCorner<3, 3>() = R;
-  H = (Ad.transpose() * H * Ad).eval();
-  b = (Ad.transpose() * b).eval();
-}
-
 /// A symmetric 3x3 by its upper triangle: half the memory of a Matrix3d (GICP's weights, covariances).
 struct Sym3 {
   double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;

@@ -19,8 +19,8 @@ constexpr double kNegligible = 30.0;
 
 class NdtObjective final : public detail::Objective {
  public:
-  NdtObjective(const NdtGrid& grid, const PointCloud& source, const Pose& anchor, const NdtParams& params)
-      : grid_(grid), source_(source), anchor_(anchor.matrix()), anchored_(!anchor_.isIdentity(0.0)), params_(params) {
+  NdtObjective(const NdtGrid& grid, const PointCloud& source, const NdtParams& params)
+      : grid_(grid), source_(source), params_(params) {
     // PCL's constants (Magnusson 2009, eq. 6.8): a Gaussian plus a uniform outlier floor, fitted by
     // a single Gaussian-shaped score so the derivatives stay simple.
     const double c1 = 10.0 * (1.0 - params.outlier_ratio);
@@ -70,7 +70,7 @@ class NdtObjective final : public detail::Objective {
   };
 
   std::optional<Sums> run(const Pose& T, const Deadline& deadline) const {
-    const Eigen::Matrix4d M = anchor_ * T.matrix();
+    const Eigen::Matrix4d M = T.matrix();
     std::atomic<bool> stopped{false};
     Sums total = parallelReduce(chunks_, params_.num_threads, Sums{}, [&](std::size_t t) {
       Sums part;
@@ -121,11 +121,6 @@ class NdtObjective final : public detail::Objective {
       return part;
     });
     if (stopped.load()) return std::nullopt;
-    if (anchored_) {
-      detail::toSharedTwist(anchor_, total.sys.H, total.sys.b);
-      Vector6d unused = Vector6d::Zero();
-      detail::toSharedTwist(anchor_, total.H_newton, unused);
-    }
     return total;
   }
 
@@ -133,8 +128,6 @@ class NdtObjective final : public detail::Objective {
   Eigen::Matrix4d cached_at_ = Eigen::Matrix4d::Zero();
   const NdtGrid& grid_;
   const PointCloud& source_;
-  const Eigen::Matrix4d anchor_;
-  const bool anchored_;
   const NdtParams& params_;
   double d1_ = 0.0, d2_ = 0.0;
   std::size_t chunks_ = 0;
@@ -144,12 +137,8 @@ class NdtObjective final : public detail::Objective {
 
 RegistrationResult alignNdt(const Target& target, const PointCloud& source, const Pose& guess,
                             const NdtParams& params, const Deadline& deadline) {
-  return alignNdt(SourceTarget{&source, &target}, guess, params, deadline);
-}
-
-RegistrationResult alignNdt(const SourceTarget& pair, const Pose& guess, const NdtParams& params,
-                            const Deadline& deadline) {
   constexpr const char* kName = "NDT";
+  const SourceTarget pair{&source, &target};
   std::string bad = detail::validateInputs({&pair, 1}, guess, params, params.max_correspondence_distance);
   char buf[160];
   if (bad.empty() && !(params.outlier_ratio > 0.0 && params.outlier_ratio < 1.0)) {
@@ -157,7 +146,7 @@ RegistrationResult alignNdt(const SourceTarget& pair, const Pose& guess, const N
     bad = buf;
   }
   if (bad.empty() && !(params.step_size > 0.0)) bad = "step_size must be > 0";
-  const NdtGrid* grid = bad.empty() ? pair.target->ndtGrid(params.resolution) : nullptr;
+  const NdtGrid* grid = bad.empty() ? target.ndtGrid(params.resolution) : nullptr;
   if (bad.empty() && grid == nullptr) {
     std::snprintf(buf, sizeof buf, "target has no NDT grid of resolution %g m (add it to ndt_resolutions)",
                   params.resolution);
@@ -165,7 +154,7 @@ RegistrationResult alignNdt(const SourceTarget& pair, const Pose& guess, const N
   }
   if (bad.empty() && grid->empty()) bad = "target's NDT grid has no voxel with enough points";
   if (!bad.empty()) return detail::invalid(guess, std::string(kName) + ": " + bad, params.max_correspondence_distance);
-  NdtObjective objective(*grid, *pair.source, pair.anchor, params);
+  NdtObjective objective(*grid, source, params);
   const std::span<const SourceTarget> pairs(&pair, 1);
   const detail::SolveOutcome outcome = detail::solve(objective, guess, params, deadline);
   return detail::finish(outcome, objective, pairs, params.max_correspondence_distance, params, deadline, kName);

@@ -163,9 +163,8 @@ std::string validateInputs(std::span<const SourceTarget> pairs, const Pose& gues
   if (params.max_iterations < 0 || params.num_threads < 1) return "max_iterations < 0 or num_threads < 1";
   std::size_t source_points = 0;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
-    const auto& [source, target, anchor] = pairs[i];
+    const auto& [source, target] = pairs[i];
     if (source == nullptr || target == nullptr) return "null source or target";
-    if (!anchor.matrix().allFinite()) return "an anchor is not finite";
     for (const auto& p : source->points) {
       if (!p.allFinite() || p.w() != 1.0) return "source contains non-finite points (build it with fromScan/fromTable)";
     }

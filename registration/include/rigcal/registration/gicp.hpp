@@ -21,8 +21,5 @@ struct GicpParams : SolverParams {
 /// The target must be built with TargetOptions::normals_and_covariances.
 RegistrationResult alignGicp(const Target& target, const PointCloud& source, const Pose& guess,
                              const GicpParams& params = {}, const Deadline& deadline = {});
-/// The same for a pair with an anchor (SourceTarget::anchor): the result is T with the source at anchor·T.
-RegistrationResult alignGicp(SourceTarget pair, const Pose& guess, const GicpParams& params = {},
-                             const Deadline& deadline = {});
 
 }  // namespace rigcal::registration

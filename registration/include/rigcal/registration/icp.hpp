@@ -22,8 +22,5 @@ struct IcpParams : SolverParams {
 /// TargetOptions::normals_and_covariances. Never throws for bad data: see RegistrationResult::status.
 RegistrationResult alignIcp(const Target& target, const PointCloud& source, const Pose& guess,
                             const IcpParams& params = {}, const Deadline& deadline = {});
-/// The same for a pair with an anchor (SourceTarget::anchor): the result is T with the source at anchor·T.
-RegistrationResult alignIcp(const SourceTarget& pair, const Pose& guess, const IcpParams& params = {},
-                            const Deadline& deadline = {});
 
 }  // namespace rigcal::registration

@@ -27,8 +27,5 @@ struct NdtParams : SolverParams {
 
 RegistrationResult alignNdt(const Target& target, const PointCloud& source, const Pose& guess,
                             const NdtParams& params = {}, const Deadline& deadline = {});
-/// The same for a pair with an anchor (SourceTarget::anchor): the result is T with the source at anchor·T.
-RegistrationResult alignNdt(const SourceTarget& pair, const Pose& guess, const NdtParams& params = {},
-                            const Deadline& deadline = {});
 
 }  // namespace rigcal::registration

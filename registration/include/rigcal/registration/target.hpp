@@ -6,7 +6,6 @@
 #include <span>
 #include <vector>
 
-#include "rigcal/core/pose.hpp"
 #include "rigcal/registration/covariance.hpp"
 #include "rigcal/registration/nearest_neighbors.hpp"
 #include "rigcal/registration/ndt_grid.hpp"
@@ -74,14 +73,10 @@ class Target {
   std::vector<Eigen::Vector3f> normals_float_;
 };
 
-/// One (source, target) pair of a registration or evaluation. Non-owning.
+/// One (source, target) pair of a batched registration or evaluation. Non-owning.
 struct SourceTarget {
   const PointCloud* source = nullptr;
   const Target* target = nullptr;
-  /// The pair's source lands in its target at anchor·T·p, T being the pose solved for (shared by all pairs
-  /// of a batch). Identity: T is T_target_source. Lets one Target, kept in a common frame (a map), serve
-  /// pairs whose poses differ by known transforms instead of each pair building its own in its frame.
-  Pose anchor = Pose::Identity();
 };
 
 }  // namespace rigcal::registration
