@@ -90,12 +90,13 @@ TEST(UdpSource, ReceivesEveryDatagramInOrderAcrossBatchesWithKernelTimestamps) {
   // Probe until a datagram read 20 ms after its sending carries the earlier, arrival time.
   bool stamping = false;
   int probes = 0;
-  for (int probe = 0; probe < 100 && !stamping; ++probe, ++probes) {
+  while (!stamping && probes < 100) {
+    ++probes;
     sender.send(source.port(), payload(8, 255));
     std::this_thread::sleep_for(milliseconds(20));
     const TimeNs read_at = realtimeNow();
     const auto p = source.next();
-    ASSERT_TRUE(p) << "probe " << probe;
+    ASSERT_TRUE(p) << "probe " << probes;
     stamping = p->receive_ns < read_at;
   }
   ASSERT_TRUE(stamping) << "the kernel never stamped a datagram on arrival";
