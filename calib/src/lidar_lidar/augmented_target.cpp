@@ -9,6 +9,7 @@
 
 #include "rigcal/calib/lidar_lidar/source_neighbourhood.hpp"
 #include "rigcal/pipeline/target_window_picks.hpp"
+#include "rigcal/registration/parallel.hpp"
 #include "rigcal/registration/voxel_accumulator.hpp"
 
 namespace rigcal::calib {
@@ -89,25 +90,49 @@ registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& data
   };
 
   const Pose T_scan_map = dataset.frames[frame].pairing.T_map_mapping_at_scan.inverse();
-  // Each cloud is cropped and voxelised before the next (the same centroids as voxelising the whole crop
-  // at once), so the deadline is looked at between clouds for all of the work.
-  std::optional<registration::VoxelAccumulator> voxels;
-  std::vector<Eigen::Vector4d> cropped;
+  // The window's clouds are cut into fixed pieces cropped on the threads (a mapping cloud alone, ~20k points
+  // at the dense leaf, is too little work to share), then voxelised batch by batch in their order: the
+  // same centroids as voxelising the whole crop at once, for any thread count. The deadline is looked at
+  // in every piece and between batches.
+  constexpr std::size_t kCropPiece = 16384;
+  constexpr std::size_t kVoxelBatch = 1 << 17;
+  struct Piece {
+    const pipeline::MappingCloud* cloud;
+    Eigen::Matrix4f T_scan_cloud;
+    std::size_t begin, end;
+  };
+  std::vector<Piece> pieces;
   for (const std::size_t i : window) {
-    if (options.deadline.expired()) return {};
     const auto& mc = dataset.mapping_clouds[i];
     const Eigen::Matrix4f T = (T_scan_map * mc.frame.T_map_lidar).matrix().cast<float>();
-    const Scan& s = *mc.cloud;
-    cropped.clear();
-    for (std::size_t j = 0; j < s.size(); ++j) {
-      const Eigen::Vector4f q = T * Eigen::Vector4f(s.x[j], s.y[j], s.z[j], 1.0F);
+    for (std::size_t b = 0; b < mc.cloud->size(); b += kCropPiece)
+      pieces.push_back({&mc, T, b, std::min(mc.cloud->size(), b + kCropPiece)});
+  }
+  std::vector<std::vector<Eigen::Vector4d>> kept(pieces.size());
+  registration::parallelFor(pieces.size(), options.num_threads, [&](std::size_t k) {
+    if (options.deadline.expired()) return;
+    const Piece& piece = pieces[k];
+    const Scan& s = *piece.cloud->cloud;
+    for (std::size_t j = piece.begin; j < piece.end; ++j) {
+      const Eigen::Vector4f q = piece.T_scan_cloud * Eigen::Vector4f(s.x[j], s.y[j], s.z[j], 1.0F);
       const Eigen::Vector3d qd = q.head<3>().cast<double>();
       if (!qd.allFinite() || !keep(qd)) continue;
-      cropped.emplace_back(qd.x(), qd.y(), qd.z(), 1.0);
+      kept[k].emplace_back(qd.x(), qd.y(), qd.z(), 1.0);
     }
-    if (cropped.empty()) continue;
-    if (!voxels) voxels.emplace(params.leaf_size_dense_map, cropped.size() * window.size());
-    voxels->add(cropped);
+  });
+  if (options.deadline.expired()) return {};
+  std::size_t total = 0;
+  for (const auto& k : kept) total += k.size();
+  std::optional<registration::VoxelAccumulator> voxels;
+  if (total > 0) voxels.emplace(params.leaf_size_dense_map, total);
+  std::vector<Eigen::Vector4d> batch;
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    batch.insert(batch.end(), kept[k].begin(), kept[k].end());
+    std::vector<Eigen::Vector4d>().swap(kept[k]);
+    if (batch.size() < kVoxelBatch && k + 1 < kept.size()) continue;
+    if (options.deadline.expired()) return {};
+    if (!batch.empty()) voxels->add(batch, options.num_threads);
+    batch.clear();
   }
   if (clouds_used != nullptr) *clouds_used = window.size();
   if (points_before_voxel != nullptr) *points_before_voxel = voxels ? voxels->added() : 0;
