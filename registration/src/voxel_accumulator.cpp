@@ -20,11 +20,13 @@ namespace {
 // targets are alive, so each voxel costs 56 bytes plus an 8-byte slot (two Vector4d and a 28-byte slot
 // per voxel before, issue #18), and the voxels live in fixed chunks: no vector doubling that holds the old
 // and the new array at once and leaves up to half of the new one unused.
+// No initialisers: every field is set when its voxel is inserted, and chunks allocated ahead stay untouched
+// (not resident) until used.
 struct Voxel {
   Eigen::Vector3d first;  // sums are relative to the voxel's first point (as voxelDownsample): full precision
   Eigen::Vector3d sum;    // far from the origin
-  std::uint32_t count = 0;
-  std::uint32_t order = 0;  // the index of its first point among all added: the centroids' order
+  std::uint32_t count;
+  std::uint32_t order;  // the index of its first point among all added: the centroids' order
 };
 
 // The slot keeps the hash's low 32 bits (its position is those bits & mask) and the voxel's index; the
@@ -50,10 +52,15 @@ std::size_t shardOf(std::uint64_t hash) { return static_cast<std::size_t>(hash >
 
 class Shard {
  public:
+  /// The table and the voxel chunks for `expected_voxels` are allocated here, on the caller's thread: a shard
+  /// filled on a helper thread allocates only beyond them (glibc gives a helper thread its own arena, where
+  /// what it allocated and freed stays resident).
   explicit Shard(std::size_t expected_voxels) {
     std::size_t capacity = 16;
     while (capacity < 2 * expected_voxels) capacity *= 2;
     slots_.assign(capacity, Slot{});
+    chunks_.reserve(chunkCount(expected_voxels, kChunkSize) + 16);
+    for (std::size_t c = 0; c < chunkCount(expected_voxels, kChunkSize); ++c) chunks_.push_back(newChunk());
   }
 
   [[nodiscard]] std::size_t size() const { return count_; }
@@ -85,14 +92,17 @@ class Shard {
       if (slots_[s].hash == hash && holds(at(slots_[s].index), c, inv_leaf)) return at(slots_[s].index);
       s = (s + 1) & mask;
     }
-    if ((count_ & (kChunkSize - 1)) == 0) chunks_.push_back(std::make_unique<Voxel[]>(kChunkSize));
+    if (count_ == chunks_.size() * kChunkSize) chunks_.push_back(newChunk());
     slots_[s] = {hash, static_cast<std::uint32_t>(count_)};
     Voxel& v = at(count_++);
     v.first = p.head<3>();
     v.sum.setZero();
+    v.count = 0;
     v.order = order;
     return v;
   }
+
+  static std::unique_ptr<Voxel[]> newChunk() { return std::make_unique_for_overwrite<Voxel[]>(kChunkSize); }
 
   void grow() {
     std::vector<Slot> old(2 * slots_.size());
