@@ -65,6 +65,27 @@ void drain(UdpSource& source, const std::atomic<bool>& done, std::vector<Datagra
   }
 }
 
+/// Drains `source` into `received` on its own thread until stop(), which the destructor also calls: a test
+/// that fails or throws before stopping it (RIGCAL_BIN unset outside ctest) ends cleanly instead of
+/// destroying a joinable thread (std::terminate).
+class BackgroundDrain {
+ public:
+  BackgroundDrain(UdpSource& source, std::vector<Datagram>& received)
+      : thread_([this, &source, &received] { drain(source, done_, received); }) {}
+  ~BackgroundDrain() { stop(); }
+  BackgroundDrain(const BackgroundDrain&) = delete;
+  BackgroundDrain& operator=(const BackgroundDrain&) = delete;
+  /// Reads what is still queued, then returns.
+  void stop() {
+    done_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
+
 struct LiveRun {
   std::vector<Datagram> received;
   SourceStats source_stats;
@@ -236,16 +257,14 @@ TEST(ReplayCommand, RateOneTakesAboutTheCaptureDuration) {
   ASSERT_GT(span, 2 * kNsPerSec);
   UdpSource listener(listenerConfig());
   std::vector<Datagram> received;
-  std::atomic<bool> done{false};
-  std::thread reader([&] { drain(listener, done, received); });
+  BackgroundDrain reader(listener, received);
   test::TempDir dir;
   const auto t0 = Clock::now();
   const Child child = spawnRigcal(dir, {"replay", file.string(), "--to", "127.0.0.1", "--rate", "1.0", "--port",
                                         "2368", "--port-offset", std::to_string(int(listener.port()) - 2368)});
   const int code = waitExit(child);
   const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-  done = true;
-  reader.join();
+  reader.stop();
   const std::string out = slurp(child.out);
   ASSERT_EQ(code, 0) << out << slurp(child.err);
   EXPECT_NE(out.find("replayed " + std::to_string(expected.size()) + " packets"), std::string::npos) << out;
@@ -267,16 +286,14 @@ TEST(ReplayCommand, LoopRunsUntilInterruptedAndSummarises) {
   RIGCAL_REQUIRE_DATA(file, "ouster/OS-1-32-G_v2.1.1_1024x10.pcap");  // 0.1 s per pass
   UdpSource listener(listenerConfig());
   std::vector<Datagram> received;
-  std::atomic<bool> done{false};
-  std::thread reader([&] { drain(listener, done, received); });
+  BackgroundDrain reader(listener, received);
   test::TempDir dir;
   const Child child = spawnRigcal(dir, {"replay", file.string(), "--to", "127.0.0.1", "--loop", "--port", "7502",
                                         "--port-offset", std::to_string(int(listener.port()) - 7502)});
   std::this_thread::sleep_for(std::chrono::milliseconds(800));
   kill(child.pid, SIGINT);
   const int code = waitExit(child);
-  done = true;
-  reader.join();
+  reader.stop();
   const std::string out = slurp(child.out);
   EXPECT_EQ(code, 130) << out << slurp(child.err);
   EXPECT_NE(out.find("replayed "), std::string::npos) << out;
