@@ -32,27 +32,6 @@ TEST(VoxelAccumulator, BatchByBatchIsBitIdenticalToOnePass) {
   for (std::size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got.points[i], expected.points[i]) << "centroid " << i;
 }
 
-// Filled by two threads (its voxels split among shards that each take their points in order), the centroids
-// are still voxelDownsample's, bit for bit and in its order, and a dropped point is counted once.
-TEST(VoxelAccumulator, TwoThreadsGiveTheOnePassCentroidsInTheirOrder) {
-  PointCloud whole = test::room(0.03);
-  for (auto& p : whole.points) p.head<3>() += Eigen::Vector3d(-2500.3, 731.9, 4.4);
-  for (std::size_t i = 0; i < whole.size(); i += 1000) whole.points[i].y() = std::numeric_limits<double>::quiet_NaN();
-  VoxelGridStats stats;
-  const PointCloud expected = voxelDownsample(whole, 0.05, &stats);
-  ASSERT_GT(stats.dropped, 0u);
-  VoxelAccumulator acc(0.05);
-  const std::size_t batch = 50021;
-  for (std::size_t b = 0; b < whole.size(); b += batch) {
-    const std::size_t e = std::min(whole.size(), b + batch);
-    acc.add(std::span<const Eigen::Vector4d>(whole.points.data() + b, e - b), 2);
-  }
-  EXPECT_EQ(acc.dropped(), stats.dropped);
-  const PointCloud got = acc.centroids();
-  ASSERT_EQ(got.size(), expected.size());
-  for (std::size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got.points[i], expected.points[i]) << "centroid " << i;
-}
-
 TEST(VoxelAccumulator, DropsNonFinitePointsAndRejectsABadLeaf) {
   VoxelAccumulator acc(0.1);
   const std::vector<Eigen::Vector4d> pts = {{0.01, 0.02, 0.03, 1.0},

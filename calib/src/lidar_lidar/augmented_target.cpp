@@ -1,7 +1,6 @@
 #include "rigcal/calib/lidar_lidar/augmented_target.hpp"
 
 #include <algorithm>
-#include <cstdint>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -10,7 +9,6 @@
 
 #include "rigcal/calib/lidar_lidar/source_neighbourhood.hpp"
 #include "rigcal/pipeline/target_window_picks.hpp"
-#include "rigcal/registration/parallel.hpp"
 #include "rigcal/registration/voxel_accumulator.hpp"
 
 namespace rigcal::calib {
@@ -91,60 +89,25 @@ registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& data
   };
 
   const Pose T_scan_map = dataset.frames[frame].pairing.T_map_mapping_at_scan.inverse();
-  // The window's clouds are cut into fixed pieces whose points are tested on the threads a group at a time
-  // (a mapping cloud alone is too little work to share; the test, not the transform, is the cost), then the
-  // kept points are gathered and voxelised in order before the next group: the same centroids as
-  // voxelising the whole crop at once, for any thread count, with never more than a group's crop held and
-  // nothing allocated on a helper thread. The deadline is looked at in every piece and between groups.
-  constexpr std::size_t kCropPiece = 16384;
-  constexpr std::size_t kPiecesPerGroup = 4;  // 64k points: at most a 2 MB crop held
-  struct Piece {
-    const Scan* cloud;
-    Eigen::Matrix4f T_scan_cloud;
-    std::size_t begin, end;
-  };
-  std::vector<Piece> pieces;
-  std::size_t window_points = 0;
+  // Each cloud is cropped and voxelised before the next (the same centroids as voxelising the whole crop
+  // at once), so the deadline is looked at between clouds for all of the work.
+  std::optional<registration::VoxelAccumulator> voxels;
+  std::vector<Eigen::Vector4d> cropped;
   for (const std::size_t i : window) {
+    if (options.deadline.expired()) return {};
     const auto& mc = dataset.mapping_clouds[i];
     const Eigen::Matrix4f T = (T_scan_map * mc.frame.T_map_lidar).matrix().cast<float>();
-    for (std::size_t b = 0; b < mc.cloud->size(); b += kCropPiece)
-      pieces.push_back({mc.cloud.get(), T, b, std::min(mc.cloud->size(), b + kCropPiece)});
-    window_points += mc.cloud->size();
-  }
-  const auto placed = [](const Piece& piece, std::size_t j) {
-    const Scan& s = *piece.cloud;
-    const Eigen::Vector4f q = piece.T_scan_cloud * Eigen::Vector4f(s.x[j], s.y[j], s.z[j], 1.0F);
-    return Eigen::Vector3d(q.head<3>().cast<double>());
-  };
-  std::optional<registration::VoxelAccumulator> voxels;
-  std::vector<std::uint8_t> kept(kPiecesPerGroup * kCropPiece);
-  std::vector<Eigen::Vector4d> group_crop;
-  for (std::size_t first = 0; first < pieces.size(); first += kPiecesPerGroup) {
-    const std::size_t count = std::min(kPiecesPerGroup, pieces.size() - first);
-    registration::parallelFor(count, options.num_threads, [&](std::size_t k) {
-      if (options.deadline.expired()) return;
-      const Piece& piece = pieces[first + k];
-      std::uint8_t* flags = kept.data() + k * kCropPiece;
-      for (std::size_t j = piece.begin; j < piece.end; ++j) {
-        const Eigen::Vector3d q = placed(piece, j);
-        flags[j - piece.begin] = q.allFinite() && keep(q);
-      }
-    });
-    if (options.deadline.expired()) return {};
-    group_crop.clear();
-    std::size_t group_points = 0;
-    for (std::size_t k = 0; k < count; ++k) {
-      const Piece& piece = pieces[first + k];
-      const std::uint8_t* flags = kept.data() + k * kCropPiece;
-      for (std::size_t j = piece.begin; j < piece.end; ++j)
-        if (flags[j - piece.begin] != 0) group_crop.emplace_back(placed(piece, j).homogeneous());
-      group_points += piece.end - piece.begin;
+    const Scan& s = *mc.cloud;
+    cropped.clear();
+    for (std::size_t j = 0; j < s.size(); ++j) {
+      const Eigen::Vector4f q = T * Eigen::Vector4f(s.x[j], s.y[j], s.z[j], 1.0F);
+      const Eigen::Vector3d qd = q.head<3>().cast<double>();
+      if (!qd.allFinite() || !keep(qd)) continue;
+      cropped.emplace_back(qd.x(), qd.y(), qd.z(), 1.0);
     }
-    if (group_crop.empty()) continue;
-    // Sized from the first group's crop rate, which holds for the rest of the window.
-    if (!voxels) voxels.emplace(params.leaf_size_dense_map, group_crop.size() * window_points / group_points);
-    voxels->add(group_crop, options.num_threads);
+    if (cropped.empty()) continue;
+    if (!voxels) voxels.emplace(params.leaf_size_dense_map, cropped.size() * window.size());
+    voxels->add(cropped);
   }
   if (clouds_used != nullptr) *clouds_used = window.size();
   if (points_before_voxel != nullptr) *points_before_voxel = voxels ? voxels->added() : 0;

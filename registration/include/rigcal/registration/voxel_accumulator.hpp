@@ -21,10 +21,8 @@ class VoxelAccumulator {
   VoxelAccumulator(const VoxelAccumulator&) = delete;
   VoxelAccumulator& operator=(const VoxelAccumulator&) = delete;
 
-  /// Non-finite points and points beyond any voxel are dropped (counted), as in voxelDownsample. Up to
-  /// num_threads threads fill it, with the same result for any count. Throws std::length_error beyond
-  /// 2^32 - 1 points in all.
-  void add(std::span<const Eigen::Vector4d> points, int num_threads = 1);
+  /// Non-finite points and points beyond any voxel are dropped (counted), as in voxelDownsample.
+  void add(std::span<const Eigen::Vector4d> points);
   [[nodiscard]] std::size_t added() const { return added_; }
   [[nodiscard]] std::size_t dropped() const { return dropped_; }
   [[nodiscard]] std::size_t voxels() const;
