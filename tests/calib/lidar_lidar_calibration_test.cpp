@@ -17,6 +17,7 @@
 #include "rigcal/calib/lidar_lidar/ensemble_plan.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_worker.hpp"
 #include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
 #include "rigcal/calib/outputs/cloud_writers.hpp"
 #include "rigcal/calib/outputs/overview_png_writer.hpp"
@@ -39,7 +40,10 @@ std::vector<LidarLidarResult> calibrateInTurn(const std::vector<pipeline::Calibr
                                               const config::Parameters& params) {
   CalibrationBudget budget(Clock::now(), params.calibration_deadline_s, datasets.size());
   std::vector<LidarLidarResult> results;
-  for (const auto& d : datasets) results.push_back(calibrateLidarLidar(d, params, budget.next()));
+  for (const auto& d : datasets) {
+    const auto share = budget.next();
+    results.push_back(calibrateLidarLidar(d, params, share, optionsForShare({}, budget)));
+  }
   return results;
 }
 
@@ -137,6 +141,7 @@ TEST_F(LidarLidarSim, RepeatedRunsGiveIdenticalResults) {
   const auto deadline = registration::Deadline::after(std::chrono::seconds(600));
   LidarLidarOptions two_threads, one_thread;
   two_threads.exhaustive = one_thread.exhaustive = false;  // a run that ends by itself, not by the clock
+  two_threads.trajectory_clock = one_thread.trajectory_clock = true;
   one_thread.num_threads = 1;
   const auto a = calibrateLidarLidar(d, params, deadline, two_threads);
   const auto b = calibrateLidarLidar(d, params, deadline, one_thread);
@@ -147,6 +152,42 @@ TEST_F(LidarLidarSim, RepeatedRunsGiveIdenticalResults) {
       << a.T_mapping_calib.matrix() << "\nvs\n" << b.T_mapping_calib.matrix();
   EXPECT_EQ(a.final_score.value, b.final_score.value);
   EXPECT_EQ(a.runs.size(), b.runs.size());
+  ASSERT_NE(a.trajectory_clock.status, TrajectoryClockEstimate::Status::kNotRun);
+  EXPECT_EQ(a.trajectory_clock.status, b.trajectory_clock.status);
+  EXPECT_EQ(a.trajectory_clock.offset_ms, b.trajectory_clock.offset_ms);
+  EXPECT_EQ(a.trajectory_clock.profile, b.trajectory_clock.profile) << "its residual passes, on 2 threads or 1";
+}
+
+// After a complete plan the searches for another basin use `search_share` of the time left and no more:
+// the rest goes to the lidars still to come (LidarLidarWorker: 0.5 while others wait).
+TEST_F(LidarLidarSim, TheSearchesForAnotherBasinKeepToTheirShare) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock bounds measured in the optimised build only";
+  config::Parameters params = data().params;
+  auto d = data().datasets.front();
+  d.frames.resize(2);  // a plan far shorter than the share
+  constexpr double kShare = 4.0;  // s
+  const auto run = [&](double search_share) {
+    LidarLidarOptions o;
+    o.search_share = search_share;
+    o.trajectory_clock = true;
+    const auto r = calibrateLidarLidar(d, params, registration::Deadline::after(std::chrono::seconds(4)), o);
+    std::printf("search_share %.1f: %.3f s of %.1f, %zu runs\n", search_share, r.seconds, kShare, r.runs.size());
+    return r;
+  };
+  const auto none = run(0.0), half = run(0.5), all = run(1.0);
+  for (const LidarLidarResult* r : {&none, &half, &all}) {
+    ASSERT_TRUE(r->ok) << r->failure;
+    EXPECT_FALSE(r->deadline_reached) << "the searches' end is not a cut plan";
+    EXPECT_NE(r->trajectory_clock.status, TrajectoryClockEstimate::Status::kNotRun);
+  }
+  const double plan = none.seconds;  // the plan and the clock estimate, no search
+  ASSERT_LT(plan, 0.6 * kShare) << "the plan must leave time to search for this test to say anything";
+  // (Bounds for a Release ctest -j 2: one registration of the search may overrun its end by ~0.2 s.)
+  EXPECT_LT(half.seconds, plan + 0.5 * (kShare - plan) + 0.4) << "half of what the plan left, no more";
+  EXPECT_GT(half.runs.size(), none.runs.size()) << "it did search";
+  // The whole share, unless the exhaustive pass ran out of untried starts first (3.5-3.7 s on a quiet machine).
+  EXPECT_GE(all.runs.size(), half.runs.size());
+  EXPECT_LE(all.seconds, kShare + 0.05);
 }
 
 // The re-deskew and its batched chain come right after the first chain, before the other frames'
@@ -226,6 +267,14 @@ TEST(CalibrationBudget, SharesWhatIsLeftEquallyAndHandsOnUnusedTime) {
   EXPECT_NEAR(std::chrono::duration<double>(second.when() - start).count(), 1.5, 0.05);
   const auto third = budget.next();
   EXPECT_NEAR(std::chrono::duration<double>(third.when() - start).count(), 3.0, 0.05);
+  EXPECT_FALSE(budget.othersToCome()) << "the third lidar's share was all that was left";
+  CalibrationBudget two(start, 2.0, 2);
+  (void)two.next();
+  EXPECT_TRUE(two.othersToCome());
+  EXPECT_EQ(optionsForShare({}, two).search_share, 0.5) << "half of what its plan leaves goes on";
+  (void)two.next();
+  EXPECT_FALSE(two.othersToCome());
+  EXPECT_EQ(optionsForShare({}, two).search_share, 1.0);
   CalibrationBudget unlimited(start, 0.0, 2);
   EXPECT_FALSE(unlimited.limited());
   EXPECT_FALSE(unlimited.next().expired());

@@ -36,6 +36,7 @@ registration::Deadline CalibrationBudget::next() {
   paused_ = false;
   if (!limited_) return registration::Deadline::never(cancel_);
   const std::size_t share = remaining_runs_;
+  others_to_come_ = share > 1;
   if (remaining_runs_ > 1) --remaining_runs_;
   if (now >= end_) return registration::Deadline::at(end_, cancel_);
   return registration::Deadline::at(now + (end_ - now) / static_cast<long>(share), cancel_);

@@ -24,9 +24,10 @@ TrajectoryClockEstimate trajectoryClock(const pipeline::CalibrationDataset& data
   std::vector<TrajectoryClockFrame> frames;
   for (const auto& f : calibrator.frames())
     frames.push_back({&f.source, f.target.get(), dataset.frames[f.index].pairing.scan_stamp_ns});
+  TrajectoryClockOptions clock = options.trajectory_clock_options;
+  clock.num_threads = options.num_threads;
   try {
-    return estimateTrajectoryClockOffset(frames, dataset.trajectory, result.T_mapping_calib, deadline,
-                                         options.trajectory_clock_options);
+    return estimateTrajectoryClockOffset(frames, dataset.trajectory, result.T_mapping_calib, deadline, clock);
   } catch (const std::exception& e) {  // a trajectory it cannot interpolate: no estimate, the calibration stands
     TrajectoryClockEstimate none;
     none.status = TrajectoryClockEstimate::Status::kUnobservable;
@@ -47,6 +48,16 @@ void frameInformation(const detail::Calibrator& calibrator, const config::Parame
                                                                params.calibration_eval_max_corr_distance, stride);
 }
 
+/// Where the searches for another basin stop: `search_share` of the time left, less what a second clock
+/// estimate would take (as long as the first, and half again) should they find a better result.
+registration::Deadline searchDeadline(const registration::Deadline& deadline, const LidarLidarOptions& options,
+                                      const LidarLidarResult& out) {
+  if (deadline.when() == registration::Deadline::Clock::time_point::max()) return deadline;
+  const double reestimate = options.trajectory_clock ? 1.5 * out.trajectory_clock.seconds : 0.0;
+  const double left = std::max(0.0, secondsLeft(deadline) - reestimate);
+  return earlierBy(deadline, reestimate + (1.0 - std::clamp(options.search_share, 0.0, 1.0)) * left);
+}
+
 /// calibrateLidarLidar; `drop_clouds` is null or `dataset`, whose mapping clouds then go as the targets are built.
 LidarLidarResult calibrate(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
                            const registration::Deadline& deadline, const LidarLidarOptions& options,
@@ -60,23 +71,25 @@ LidarLidarResult calibrate(const pipeline::CalibrationDataset& dataset, const co
   if (deadline.when() != registration::Deadline::Clock::time_point::max())
     out.deadline_share_s = std::max(0.0, secondsLeft(deadline));
   out.failure = validateDataset(dataset, params);
-  // The trajectory clock estimate's time comes off the end of the calibration's (its exhaustive ensemble).
-  const registration::Deadline calibration_deadline =
-      options.trajectory_clock
-          ? earlierBy(deadline, std::min(options.trajectory_clock_max_s,
-                                         options.trajectory_clock_share * std::max(0.0, secondsLeft(deadline))))
-          : deadline;
   if (out.failure.empty()) {
     try {
       detail::Calibrator::TargetsDone release;
       if (drop_clouds != nullptr)
         release = [drop_clouds](std::size_t first_pending) { dropMappingCloudsDoneWith(*drop_clouds, first_pending); };
-      detail::Calibrator calibrator(dataset, params, calibration_deadline, options, out, release);
-      calibrator.run();
+      detail::Calibrator calibrator(dataset, params, deadline, options, out, release);
+      const bool plan_complete = calibrator.run();
       // A plan cut before its last target: the clouds of the frames never built go too.
       if (release) release(dataset.frames.size());
-      if (out.ok) frameInformation(calibrator, params, out);
-      if (options.trajectory_clock && out.ok) out.trajectory_clock = trajectoryClock(dataset, calibrator, out, deadline, options);
+      // The evidence the verdict weighs besides the runs: each frame's information, the clock's offset.
+      const auto evidence = [&] {
+        if (out.ok) frameInformation(calibrator, params, out);
+        if (options.trajectory_clock && out.ok)
+          out.trajectory_clock = trajectoryClock(dataset, calibrator, out, deadline, options);
+      };
+      evidence();
+      // Only a complete plan searches further (the clock estimate came first: the plan reserved its time).
+      if (plan_complete && calibrator.searchForAnotherBasin(searchDeadline(deadline, options, out)))
+        evidence();
     } catch (const std::exception& e) {  // a bad dataset the validation did not foresee: a clear failure
       out.ok = false;
       out.T_mapping_calib = dataset.T_mapping_calib_guess;  // validated finite

@@ -1,5 +1,5 @@
 // The run: the most informative frame first, then the others' targets, the batched ICP, the re-deskew,
-// the other frames' ensembles, and whatever time is left for the searches for another basin; the
+// the other frames' ensembles; the searches for another basin in the time the caller gives them; the
 // all-frames scores that pick the best candidate.
 #include "lidar_lidar_calibrator.hpp"
 
@@ -10,23 +10,52 @@
 
 namespace rigcal::calib::detail {
 
-void Calibrator::run() {
+Calibrator::Calibrator(const pipeline::CalibrationDataset& dataset, const config::Parameters& params,
+                       const Deadline& share, const LidarLidarOptions& options, LidarLidarResult& out,
+                       TargetsDone targets_done)
+    : data_(dataset), params_(params), share_(share), deadline_(share), opt_(options), out_(out),
+      targets_done_(std::move(targets_done)) {
+  if (opt_.trajectory_clock)  // until a score was timed (rescore)
+    deadline_ = earlierBy(share_, std::min(opt_.trajectory_clock_max_s,
+                                           opt_.trajectory_clock_share * std::max(0.0, secondsLeft(share_))));
+}
+
+bool Calibrator::run() {
   out_.candidates = {data_.T_mapping_calib_guess};
   best_ = data_.T_mapping_calib_guess;
   std::size_t next = 0;  // the next dataset frame to build
-  if (!firstFrame(next)) return;
+  if (!firstFrame(next)) return false;
   const std::size_t first_frames = frames_.size();
   const bool targets_cut = laterTargets(next, first_frames);
   const bool finished = restOfPlan(first_frames);
-  if (finished) searchForAnotherBasin();
   // A run cancelled from outside (the user stopping it) is cut wherever it was.
   const bool cancelled = deadline_.token() != nullptr && deadline_.token()->cancelled();
   out_.deadline_reached = targets_cut || !finished || cancelled;
+  publish();
+  return !out_.deadline_reached;
+}
+
+bool Calibrator::searchForAnotherBasin(const Deadline& until) {
+  // Upstream's batched chain from the initial guess (on the street's VLS-128 map it ran its 200 iterations
+  // at 0.5 m without converging: 0.6 s of a 3.3 s share), then its exhaustive ensemble (every registrator
+  // from every candidate); a better result gets the final batched refinement too.
+  deadline_ = until.when() < share_.when() ? until : share_;
+  const auto t = Clock::now();
+  const Pose before_search = best_;
+  if (!stopped()) batchedChain(data_.T_mapping_calib_guess);
+  for (std::size_t k = 0; k < frames_.size() && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
+  if (!samePose(before_search, best_) && !stopped()) batchedChain(best_);
+  seconds_.ensemble += since(t);
+  if (deadline_.token() != nullptr && deadline_.token()->cancelled()) out_.deadline_reached = true;
+  publish();
+  return !samePose(before_search, best_);
+}
+
+void Calibrator::publish() {
   out_.stage_seconds = {{"targets", seconds_.targets},
                         {"ensemble", seconds_.ensemble},
                         {"batched", seconds_.batched},
                         {"redeskew_final", seconds_.redeskew_final}};
-
   out_.T_mapping_calib = best_;
   out_.final_score = best_score_;
   if (!finitePose(best_)) {  // cannot happen (registrations never return NaN) but never hand one out
@@ -34,12 +63,24 @@ void Calibrator::run() {
     out_.final_score = out_.initial_score;
   }
   out_.ok = out_.final_score.betterThan(out_.initial_score);
+  out_.failure.clear();
   if (!out_.ok) {
     std::ostringstream msg;
     msg << "no registration beat the initial guess's score (" << out_.initial_score.value << " m², inliers "
         << out_.initial_score.inlier_ratio << ")" << (out_.deadline_reached ? " before the deadline" : "");
     out_.failure = msg.str();
   }
+}
+
+double Calibrator::clockEstimateSeconds() const {
+  if (!opt_.trajectory_clock || score_points_ == 0) return 0.0;
+  const auto& c = opt_.trajectory_clock_options;
+  // Its trials (and the vertex's, and one step outwards), each iterations + 1 passes over max_points.
+  const double passes = double(c.shifts_ms.size() + 2) * double(c.iterations + 1);
+  // A pass point cost 0.7-1.3 score points on the street (3 lidars, 2 threads); three leave room for a
+  // machine that gets busier after the score was timed.
+  constexpr double kPassPointInScorePoints = 3.0;
+  return kPassPointInScorePoints * passes * double(c.max_points) * score_seconds_ / double(score_points_);
 }
 
 bool Calibrator::firstFrame(std::size_t& next) {
@@ -120,22 +161,9 @@ bool Calibrator::restOfPlan(std::size_t first_frames) {
   for (std::size_t k = 1; k < frames_.size() && !stopped(); ++k) frameEnsemble(k, false);
   if (!samePose(before_ensembles, best_) && !stopped()) batchedChain(best_);
   seconds_.ensemble += since(t);
-  return !stopped();
-}
-
-void Calibrator::searchForAnotherBasin() {
-  // Here the plan is done: every frame through its ensemble, the batched chain, the re-deskew and the chain
-  // again from the best. Whatever time is left goes to the searches for another basin: upstream's batched
-  // chain from the initial guess (on the street's VLS-128 map it ran its 200 iterations at 0.5 m without
-  // converging: 0.6 s of a 3.3 s share), then its exhaustive ensemble (every registrator from every
-  // candidate); a better result gets the final batched refinement too. The deadline ending them does not
-  // make the result "the best so far of a cut plan".
-  const auto t = Clock::now();
-  const Pose before_search = best_;
-  if (!stopped()) batchedChain(data_.T_mapping_calib_guess);
-  for (std::size_t k = 0; k < frames_.size() && opt_.exhaustive && !stopped(); ++k) frameEnsemble(k, true);
-  if (!samePose(before_search, best_) && !stopped()) batchedChain(best_);
-  seconds_.ensemble += since(t);
+  // Complete only if the registrations' own deadline has not passed either: the last ones ran into it
+  // otherwise (a 1 s plan ended with two ensembles "timeout" 1 ms in, before the real deadline).
+  return !registrationDeadline().expired();
 }
 
 double Calibrator::batchedChainEstimate(std::size_t frames) const {
@@ -158,6 +186,11 @@ void Calibrator::rescore() {
   const auto ts = Clock::now();
   initial_score_ = score(data_.T_mapping_calib_guess);
   score_seconds_ = since(ts);
+  score_points_ = 0;
+  for (const auto& pair : score_pairs_) score_points_ += pair.source->size();
+  // The plan now leaves what the clock estimate after it is expected to take.
+  if (opt_.trajectory_clock)
+    deadline_ = earlierBy(share_, std::min(opt_.trajectory_clock_max_s, clockEstimateSeconds()));
   best_score_ = samePose(best_, data_.T_mapping_calib_guess) ? initial_score_ : score(best_);
   if (!best_score_.betterThan(initial_score_)) {
     best_ = data_.T_mapping_calib_guess;

@@ -48,12 +48,21 @@ class Calibrator {
   /// (calibrateLidarLidarDroppingClouds: the mapping clouds). Frames are built in order.
   using TargetsDone = std::function<void(std::size_t first_pending)>;
 
-  Calibrator(const pipeline::CalibrationDataset& dataset, const config::Parameters& params, const Deadline& deadline,
-             const LidarLidarOptions& options, LidarLidarResult& out, TargetsDone targets_done = {})
-      : data_(dataset), params_(params), deadline_(deadline), opt_(options), out_(out),
-        targets_done_(std::move(targets_done)) {}
+  /// `share`: this lidar's deadline. The plan ends early enough for the trajectory clock estimate after it
+  /// (LidarLidarOptions::trajectory_clock): at first by `trajectory_clock_share` of the share, then, once a
+  /// score was timed, by what the estimate's residual passes are expected to take.
+  Calibrator(const pipeline::CalibrationDataset& dataset, const config::Parameters& params, const Deadline& share,
+             const LidarLidarOptions& options, LidarLidarResult& out, TargetsDone targets_done = {});
 
-  void run();
+  /// The plan: the most informative frame first, then the others' targets, the batched ICP, the re-deskew and
+  /// the other frames' ensembles. out_ holds the best result (or the failure); true when the plan ran to its
+  /// end (out_.deadline_reached when the deadline cut it).
+  bool run();
+
+  /// After a complete plan, until `until` (no later than the share): upstream's batched chain from the
+  /// initial guess, then the exhaustive ensembles. True when it found a better result (out_ updated). The
+  /// deadline ending it does not make the result "the best so far of a cut plan".
+  bool searchForAnotherBasin(const Deadline& until);
 
   /// The frames registered (sources re-deskewed with the result), for the trajectory clock estimate.
   [[nodiscard]] const std::vector<Frame>& frames() const { return frames_; }
@@ -69,8 +78,12 @@ class Calibrator {
   /// The grown set's rescore, the batched chain, the re-deskew, then the other frames' ensembles; true when
   /// all of it ran.
   bool restOfPlan(std::size_t first_frames);
-  /// After the plan, until the deadline: the chain from the initial guess and the exhaustive ensembles.
-  void searchForAnotherBasin();
+  /// The best so far into out_ (result, scores, ok / failure, stage seconds).
+  void publish();
+
+  /// What the trajectory clock estimate after the plan is expected to take, from the last score's time per
+  /// point (its passes cost about as much per point); 0 when it does not run.
+  [[nodiscard]] double clockEstimateSeconds() const;
 
   /// The deadline passed (or the run was cancelled): every step stops. Whether that cut the plan is run()'s
   /// call (out_.deadline_reached): the exhaustive pass at the end only fills the time left.
@@ -124,7 +137,8 @@ class Calibrator {
 
   const pipeline::CalibrationDataset& data_;
   const config::Parameters& params_;
-  const Deadline& deadline_;
+  const Deadline share_;  // the lidar's
+  Deadline deadline_;     // the current step's: the plan's (the share less the clock's reserve), or the search's
   const LidarLidarOptions& opt_;
   LidarLidarResult& out_;
   TargetsDone targets_done_;
@@ -134,6 +148,7 @@ class Calibrator {
   } seconds_;  // out_.stage_seconds
   std::vector<SourceTarget> score_pairs_;
   double score_seconds_ = 0.0;
+  std::size_t score_points_ = 0;  // over all score pairs, when score_seconds_ was timed
   // Target build cost per point; until measured, a pessimistic guess (measured 2–7 µs on a loaded 2-core box).
   double seconds_per_point_ = 6e-6;
   double last_prepare_seconds_ = 0.0;  // the last frame's source and crop, before its target build

@@ -1,10 +1,16 @@
 #include "rigcal/calib/lidar_lidar/lidar_lidar_worker.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "rigcal/core/heap_release.hpp"
 
 namespace rigcal::calib {
+
+LidarLidarOptions optionsForShare(LidarLidarOptions options, const CalibrationBudget& budget) {
+  if (budget.othersToCome()) options.search_share = std::min(options.search_share, 0.5);
+  return options;
+}
 
 LidarLidarWorker::LidarLidarWorker(const config::Parameters& params, std::size_t calibration_lidars,
                                    const LidarLidarOptions& options, const registration::CancelToken* cancel,
@@ -71,9 +77,11 @@ void LidarLidarWorker::loop() {
     // The pipeline's freed clouds before the targets are built; the targets (and clouds) once freed.
     releaseFreedHeap();
     const auto t0 = std::chrono::steady_clock::now();
+    const registration::Deadline share = budget_.next();
+    const LidarLidarOptions options = optionsForShare(options_, budget_);
     LidarLidarResult result = keep_mapping_clouds_
-                                  ? calibrateLidarLidar(owned, params_, budget_.next(), options_)
-                                  : calibrateLidarLidarDroppingClouds(owned, params_, budget_.next(), options_);
+                                  ? calibrateLidarLidar(owned, params_, share, options)
+                                  : calibrateLidarLidarDroppingClouds(owned, params_, share, options);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     results.push_back(std::move(result));
     if (!keep_mapping_clouds_) owned.mapping_clouds = {};

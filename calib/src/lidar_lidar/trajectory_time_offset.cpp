@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "rigcal/calib/lidar_lidar/calibration_deskew.hpp"
+#include "rigcal/core/parallel.hpp"
 
 namespace rigcal::calib {
 namespace {
@@ -34,40 +35,60 @@ struct Pass {
 };
 
 /// Point-to-plane residuals of every frame's points under D_k·T (D_k: the frame's mapping pose moved by
-/// the trial offset), their Gauss-Newton system in T's own tangent (ω, v) and the truncated costs.
-Pass linearise(std::vector<FrameData>& frames, const std::vector<Pose>& D, const Pose& T, double max_distance) {
-  Pass pass;
-  pass.frame_cost.assign(frames.size(), 0.0);
+/// the trial offset), their Gauss-Newton system in T's own tangent (ω, v) and the truncated costs. Pieces
+/// of `kPiece` points of a frame are the parallel tasks, added in order: the same sums for any thread count.
+Pass linearise(std::vector<FrameData>& frames, const std::vector<Pose>& D, const Pose& T, double max_distance,
+               int num_threads) {
+  constexpr std::size_t kPiece = 512;
+  struct Piece {
+    std::size_t frame = 0, begin = 0, end = 0;
+  };
+  std::vector<Piece> pieces;
+  for (std::size_t k = 0; k < frames.size(); ++k)
+    for (std::size_t b = 0; b < frames[k].points.size(); b += kPiece)
+      pieces.push_back({k, b, std::min(frames[k].points.size(), b + kPiece)});
   const double c2 = max_distance * max_distance;
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    FrameData& f = frames[k];
-    const Pose A = D[k] * T;
+  std::vector<Pass> partial(pieces.size());
+  parallelFor(pieces.size(), num_threads, [&](std::size_t t) {
+    const Piece& piece = pieces[t];
+    FrameData& f = frames[piece.frame];
+    Pass& pass = partial[t];
+    double cost = 0.0;
+    const Pose A = D[piece.frame] * T;
     const Eigen::Matrix3d At = A.linear().transpose();
     const auto& cloud = f.target->cloud();
-    for (std::size_t i = 0; i < f.points.size(); ++i) {
+    for (std::size_t i = piece.begin; i < piece.end; ++i) {
       const Eigen::Vector3d p = f.points[i].head<3>();
       Eigen::Vector4d q;
       q << A * p, 1.0;
       registration::Neighbor nb;
       if (!f.target->tree().nearest(q, c2, &nb, f.hints[i])) {
-        pass.frame_cost[k] += c2;
+        cost += c2;
         continue;
       }
       f.hints[i] = nb.index;
       const Eigen::Vector3d n = f.target->normal(nb.index);
       const Eigen::Vector3d d = q.head<3>() - cloud.points[nb.index].head<3>();
       if (n.squaredNorm() < 0.5) {  // no normal there: the point distance, not fitted
-        pass.frame_cost[k] += std::min(d.squaredNorm(), c2);
+        cost += std::min(d.squaredNorm(), c2);
         continue;
       }
       const double r = n.dot(d);
-      pass.frame_cost[k] += std::min(r * r, c2);
+      cost += std::min(r * r, c2);
       const Eigen::Vector3d nl = At * n;
       Vector6d J;
       J << p.cross(nl), nl;
       pass.H.noalias() += J * J.transpose();
       pass.g.noalias() += J * r;
     }
+    pass.frame_cost.assign(1, cost);
+  });
+  Pass pass;
+  pass.frame_cost.assign(frames.size(), 0.0);
+  for (std::size_t t = 0; t < pieces.size(); ++t) {
+    pass.H += partial[t].H;
+    pass.g += partial[t].g;
+    pass.frame_cost[pieces[t].frame] += partial[t].frame_cost[0];
   }
   return pass;
 }
@@ -188,7 +209,7 @@ TrajectoryClockEstimate estimateTrajectoryClockOffset(const std::vector<Trajecto
     for (auto& f : frames) std::fill(f.hints.begin(), f.hints.end(), registration::KdTree::kNoHint);
     Trial t{{}, start};
     for (int it = 0;; ++it) {
-      const Pass pass = linearise(frames, D, t.fitted, options.max_distance);
+      const Pass pass = linearise(frames, D, t.fitted, options.max_distance, options.num_threads);
       if (it == options.iterations) {
         t.frame_cost = pass.frame_cost;
         break;

@@ -33,6 +33,9 @@ class CalibrationBudget {
   /// Only `runs` more lidars will come (end of input: the others got no dataset); they share what is left.
   void expectRuns(std::size_t runs);
 
+  /// The last next() left time for lidars still to come (its share was not all that is left).
+  [[nodiscard]] bool othersToCome() const { return others_to_come_; }
+
   /// The overall deadline (as of now: a pause moves it later).
   [[nodiscard]] registration::Deadline overall() const;
   [[nodiscard]] bool limited() const { return limited_; }
@@ -48,6 +51,7 @@ class CalibrationBudget {
   Clock::time_point end_ = Clock::time_point::max();
   Clock::time_point paused_at_{};
   std::size_t remaining_runs_;
+  bool others_to_come_ = false;
   const registration::CancelToken* cancel_;
 };
 

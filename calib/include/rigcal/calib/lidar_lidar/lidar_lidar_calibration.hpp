@@ -28,9 +28,15 @@ struct LidarLidarOptions {
   /// After the quick passes and the final refinement, spend the time left on upstream's exhaustive
   /// ensemble (every registrator from every candidate on every frame). Off: finish as soon as refined.
   bool exhaustive = true;
-  /// After the calibration, the residual clock offset against the mapping trajectory from the frames just
-  /// registered (trajectory_time_offset.hpp). Under a deadline it gets `trajectory_clock_share` of the time
-  /// left when the calibration starts (at most `trajectory_clock_max_s`), taken from the ensemble's end.
+  /// The share of the time a complete plan left that the searches for another basin (the batched chain from
+  /// the guess, the exhaustive ensemble) may use; the rest goes unused, to the lidars still to come
+  /// (LidarLidarWorker sets less than 1 while others wait: the street's first lidar filled its whole share
+  /// with them while the last one's plan was cut).
+  double search_share = 1.0;
+  /// After the plan, the residual clock offset against the mapping trajectory from the frames just
+  /// registered (trajectory_time_offset.hpp). Under a deadline the plan leaves it the time it is expected to
+  /// take from a timed score (at first `trajectory_clock_share` of the share; at most `trajectory_clock_max_s`);
+  /// it runs before the searches for another basin, and again should they find a better result.
   bool trajectory_clock = false;
   double trajectory_clock_share = 0.15;
   double trajectory_clock_max_s = 2.0;

@@ -18,6 +18,11 @@
 
 namespace rigcal::calib {
 
+/// `options` for the lidar whose share `budget.next()` just gave: while other lidars are still to come, half
+/// of the time its complete plan leaves goes on to them rather than to its searches for another basin
+/// (search_share at most 0.5; the street's first lidar filled its share with them, the last one's plan was cut).
+LidarLidarOptions optionsForShare(LidarLidarOptions options, const CalibrationBudget& budget);
+
 class LidarLidarWorker {
  public:
   /// `calibration_lidars`: how many datasets may come (the rig's calibration lidars).

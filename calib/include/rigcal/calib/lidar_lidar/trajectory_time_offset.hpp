@@ -44,6 +44,7 @@ struct TrajectoryClockOptions {
   /// Residuals per frame counted as independent in the curvature's σ (points on one surface share its
   /// error in the map): 200 put a flat two-frame profile (0.2 % over ±50 ms) at ± 69 ms, a 15 % one at ± 2.6 ms.
   double independent_points_per_frame = 200.0;
+  int num_threads = 1;  // the residual passes (the estimate does not depend on it)
 };
 
 struct TrajectoryClockEstimate {
