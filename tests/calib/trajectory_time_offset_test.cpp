@@ -50,7 +50,7 @@ class TrajectoryClock : public ::testing::Test {
     // Generous: accuracy is tested, not the budget (the estimate's own share is at most 2 s of it).
     const auto deadline = registration::Deadline::after(std::chrono::seconds(test::kSanitized ? 600 : 60));
     LidarLidarResult r = calibrateLidarLidar(d, params, deadline, o);
-    doubtTrajectoryClockOffset(r, 10.0);
+    doubtTrajectoryClockOffset(r, 10.0, 60.0);
     const auto& c = r.trajectory_clock;
     std::printf("%s: %s %+.2f ms (± %.2f) %s; %zu frames, %zu points, %.2f s; verdict %s\n",
                 d.calibration_sensor.c_str(), toString(c.status), c.offset_ms, c.uncertainty_ms, c.note.c_str(),
@@ -111,7 +111,8 @@ TEST(TrajectoryClockParabola, VertexOfUnevenlySpacedSamples) {
 }
 
 TEST(TrajectoryClockVerdict, OnlyASignificantEstimateBeyondTheLimitDoubts) {
-  const auto judged = [](TrajectoryClockEstimate::Status status, double offset_ms, double sigma_ms) {
+  const auto judged = [](TrajectoryClockEstimate::Status status, double offset_ms, double sigma_ms,
+                         bool packet_clocks_compared = false) {
     LidarLidarResult r;
     r.ok = true;
     r.verdict = Verdict::kOk;
@@ -121,7 +122,9 @@ TEST(TrajectoryClockVerdict, OnlyASignificantEstimateBeyondTheLimitDoubts) {
     r.trajectory_clock.status = status;
     r.trajectory_clock.offset_ms = offset_ms;
     r.trajectory_clock.uncertainty_ms = sigma_ms;
-    doubtTrajectoryClockOffset(r, 10.0);
+    if (status == TrajectoryClockEstimate::Status::kDeadline) r.trajectory_clock.profile = {{0.0, 1e-3}, {5.0, 1e-3}};
+    r.evidence.clock_measured = packet_clocks_compared;
+    doubtTrajectoryClockOffset(r, 10.0, 10.0);
     return r;
   };
   using S = TrajectoryClockEstimate::Status;
@@ -136,7 +139,15 @@ TEST(TrajectoryClockVerdict, OnlyASignificantEstimateBeyondTheLimitDoubts) {
   EXPECT_EQ(judged(S::kEstimated, 25.0, 15.0).verdict, Verdict::kOk) << "beyond it, but within 2σ of 0";
   EXPECT_EQ(judged(S::kEstimated, 38.7, 15.5).verdict, Verdict::kUnverified) << "the shm case measured";
   EXPECT_EQ(judged(S::kUnobservable, 35.0, 30.0).verdict, Verdict::kOk) << "no estimate judges nothing";
-  EXPECT_EQ(judged(S::kDeadline, 0.0, 0.0).verdict, Verdict::kOk);
+  EXPECT_EQ(judged(S::kNotRun, 35.0, 3.0).verdict, Verdict::kOk) << "not run: nothing to judge";
+  // Cut by the deadline, it is missing evidence unless the packet clocks were compared instead.
+  const auto cut = judged(S::kDeadline, 0.0, 0.0);
+  EXPECT_EQ(cut.verdict, Verdict::kUnverified);
+  EXPECT_NE(cut.doubt.find("clock: not checked, the deadline cut the estimate of front_left's clock"),
+            std::string::npos) << cut.doubt;
+  EXPECT_NE(cut.doubt.find("after 2 trial offsets"), std::string::npos) << cut.doubt;
+  EXPECT_NE(cut.doubt.find("try --deadline 20"), std::string::npos) << cut.doubt;
+  EXPECT_EQ(judged(S::kDeadline, 0.0, 0.0, /*packet_clocks_compared=*/true).verdict, Verdict::kOk);
 }
 
 }  // namespace

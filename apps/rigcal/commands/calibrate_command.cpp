@@ -255,7 +255,7 @@ void run(const CalibrateOptions& o) {
             {*in.clock_lag_ms, in.clock_lag_sigma_ms, in.clock_lag_sweeps});
         calib::doubtClockOffset(r, offset.offset_ms, kClockOffsetLimitMs, offset.uncertainty_ms);
       }
-    calib::doubtTrajectoryClockOffset(r, kClockOffsetLimitMs);
+    calib::doubtTrajectoryClockOffset(r, kClockOffsetLimitMs, rig.parameters.calibration_deadline_s);
   }
   const auto shortfalls = pipe->shortfalls();
   for (const auto& sf : shortfalls) outcome.input_summary.emplace_back(sf.sensor + "_missing", sf.message);

@@ -39,7 +39,9 @@ void doubtClockOffset(LidarLidarResult& result, double offset_ms, double limit_m
 /// no capture time: live and shared-memory input): an estimate beyond `limit_ms` that is significant
 /// (|δ| > 2σ) makes the result unverified, naming the sensor, δ ± σ and the time_offset_ns that would fix
 /// it. Not |δ| > limit + 2σ: a lidar 35 ms late over shm measured +38.7 ± 15.5 ms and its 3.6 cm error
-/// would have passed as ok. No estimate (unobservable, deadline, not run): nothing is judged.
-void doubtTrajectoryClockOffset(LidarLidarResult& result, double limit_ms);
+/// would have passed as ok. An estimate the deadline cut is missing evidence when the packet clocks were not
+/// compared either (doubtClockOffset): unverified, with the `--deadline` that would do (from `deadline_s`,
+/// the calibration_deadline_s of the run). Unobservable or not run: nothing is judged.
+void doubtTrajectoryClockOffset(LidarLidarResult& result, double limit_ms, double deadline_s);
 
 }  // namespace rigcal::calib
