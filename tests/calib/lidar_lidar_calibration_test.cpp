@@ -159,7 +159,7 @@ TEST_F(LidarLidarSim, RepeatedRunsGiveIdenticalResults) {
 }
 
 // After a complete plan the searches for another basin use `search_share` of the time left and no more:
-// the rest goes to the lidars still to come (LidarLidarWorker: 0.5 while others wait).
+// the rest goes to the lidars still to come (LidarLidarWorker: none while others wait).
 TEST_F(LidarLidarSim, TheSearchesForAnotherBasinKeepToTheirShare) {
   if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock bounds measured in the optimised build only";
   config::Parameters params = data().params;
@@ -271,7 +271,7 @@ TEST(CalibrationBudget, SharesWhatIsLeftEquallyAndHandsOnUnusedTime) {
   CalibrationBudget two(start, 2.0, 2);
   (void)two.next();
   EXPECT_TRUE(two.othersToCome());
-  EXPECT_EQ(optionsForShare({}, two).search_share, 0.5) << "half of what its plan leaves goes on";
+  EXPECT_EQ(optionsForShare({}, two).search_share, 0.0) << "what its plan leaves goes on to the next";
   (void)two.next();
   EXPECT_FALSE(two.othersToCome());
   EXPECT_EQ(optionsForShare({}, two).search_share, 1.0);

@@ -8,7 +8,7 @@
 namespace rigcal::calib {
 
 LidarLidarOptions optionsForShare(LidarLidarOptions options, const CalibrationBudget& budget) {
-  if (budget.othersToCome()) options.search_share = std::min(options.search_share, 0.5);
+  if (budget.othersToCome()) options.search_share = 0.0;
   return options;
 }
 
