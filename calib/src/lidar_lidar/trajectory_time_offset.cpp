@@ -222,6 +222,7 @@ TrajectoryClockEstimate estimateTrajectoryClockOffset(const std::vector<Trajecto
     if (!deadline.expired()) return false;
     out.status = TrajectoryClockEstimate::Status::kDeadline;
     out.note = "the deadline left no time for every trial offset";
+    for (const auto& [ms, t] : trials) out.profile.emplace_back(ms, sum(t.frame_cost) / double(out.points));
     return true;
   };
   std::vector<double> grid = options.shifts_ms;
