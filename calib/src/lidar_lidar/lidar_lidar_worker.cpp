@@ -1,6 +1,5 @@
 #include "rigcal/calib/lidar_lidar/lidar_lidar_worker.hpp"
 
-#include <algorithm>
 #include <chrono>
 
 #include "rigcal/core/heap_release.hpp"

@@ -31,7 +31,7 @@ struct LidarLidarOptions {
   /// The share of the time a complete plan left that the searches for another basin (the batched chain from
   /// the guess, the exhaustive ensemble) may use; the rest goes unused, to the lidars still to come
   /// (LidarLidarWorker sets 0 while others wait: the street's first lidar filled its whole share with them
-  /// while the last one's plan was cut).
+  /// while the second one's plan was cut).
   double search_share = 1.0;
   /// After the plan, the residual clock offset against the mapping trajectory from the frames just
   /// registered (trajectory_time_offset.hpp). Under a deadline the plan leaves it the time it is expected to

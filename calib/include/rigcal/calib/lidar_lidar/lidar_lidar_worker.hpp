@@ -21,7 +21,8 @@ namespace rigcal::calib {
 /// `options` for the lidar whose share `budget.next()` just gave: while other lidars are still to come, what
 /// its complete plan leaves goes on to their plans, not to its searches for another basin (search_share 0);
 /// the last lidar searches with all that is left. On the street the first lidar's searches had filled its
-/// share and the last one's plan was cut in every run; with half of it handed on, in 2 of 3; with all, in none.
+/// share and the second one's plan was cut in every run; with half of it handed on, in 6 of 8; with all, in
+/// none of 3.
 LidarLidarOptions optionsForShare(LidarLidarOptions options, const CalibrationBudget& budget);
 
 class LidarLidarWorker {
