@@ -258,28 +258,6 @@ TEST_F(LidarLidarSim, SeveralLidarsShareTheDeadlineFairly) {
   EXPECT_LT(results[0].seconds + results[1].seconds, 2.1);
 }
 
-TEST(CalibrationBudget, SharesWhatIsLeftEquallyAndHandsOnUnusedTime) {
-  const auto start = Clock::now();
-  CalibrationBudget budget(start, 3.0, 3);
-  const auto first = budget.next();
-  EXPECT_NEAR(std::chrono::duration<double>(first.when() - start).count(), 1.0, 0.05);
-  const auto second = budget.next();  // the first lidar used ~nothing: the rest is split in two
-  EXPECT_NEAR(std::chrono::duration<double>(second.when() - start).count(), 1.5, 0.05);
-  const auto third = budget.next();
-  EXPECT_NEAR(std::chrono::duration<double>(third.when() - start).count(), 3.0, 0.05);
-  EXPECT_FALSE(budget.othersToCome()) << "the third lidar's share was all that was left";
-  CalibrationBudget two(start, 2.0, 2);
-  (void)two.next();
-  EXPECT_TRUE(two.othersToCome());
-  EXPECT_EQ(optionsForShare({}, two).search_share, 0.0) << "what its plan leaves goes on to the next";
-  (void)two.next();
-  EXPECT_FALSE(two.othersToCome());
-  EXPECT_EQ(optionsForShare({}, two).search_share, 1.0);
-  CalibrationBudget unlimited(start, 0.0, 2);
-  EXPECT_FALSE(unlimited.limited());
-  EXPECT_FALSE(unlimited.next().expired());
-}
-
 TEST_F(LidarLidarSim, BadInputsGiveClearOneLineErrors) {
   const config::Parameters params = data().params;
   const auto& good = data().datasets.front();

@@ -15,9 +15,7 @@ Calibrator::Calibrator(const pipeline::CalibrationDataset& dataset, const config
                        TargetsDone targets_done)
     : data_(dataset), params_(params), share_(share), deadline_(share), opt_(options), out_(out),
       targets_done_(std::move(targets_done)) {
-  if (opt_.trajectory_clock)  // until a score was timed (rescore)
-    deadline_ = earlierBy(share_, std::min(opt_.trajectory_clock_max_s,
-                                           opt_.trajectory_clock_share * std::max(0.0, secondsLeft(share_))));
+  reserveClockEstimate();
 }
 
 bool Calibrator::run() {
@@ -72,15 +70,19 @@ void Calibrator::publish() {
   }
 }
 
-double Calibrator::clockEstimateSeconds() const {
-  if (!opt_.trajectory_clock || score_points_ == 0) return 0.0;
-  const auto& c = opt_.trajectory_clock_options;
-  // Its trials (and the vertex's, and one step outwards), each iterations + 1 passes over max_points.
-  const double passes = double(c.shifts_ms.size() + 2) * double(c.iterations + 1);
-  // A pass point cost 0.7-1.3 score points on the street (3 lidars, 2 threads); three leave room for a
-  // machine that gets busier after the score was timed.
-  constexpr double kPassPointInScorePoints = 3.0;
-  return kPassPointInScorePoints * passes * double(c.max_points) * score_seconds_ / double(score_points_);
+void Calibrator::reserveClockEstimate() {
+  if (!opt_.trajectory_clock) return;
+  double expected = opt_.trajectory_clock_share * std::max(0.0, secondsLeft(share_));  // until a score is timed
+  if (score_points_ > 0) {
+    const auto& c = opt_.trajectory_clock_options;
+    // Its trials (and the vertex's, and one step outwards), each iterations + 1 passes over max_points.
+    const double passes = double(c.shifts_ms.size() + 2) * double(c.iterations + 1);
+    // A pass point cost 0.7-1.3 score points on the street (3 lidars, 2 threads); three leave room for a
+    // machine that gets busier after the score was timed.
+    constexpr double kPassPointInScorePoints = 3.0;
+    expected = kPassPointInScorePoints * passes * double(c.max_points) * score_seconds_ / double(score_points_);
+  }
+  deadline_ = earlierBy(share_, std::min(opt_.trajectory_clock_max_s, expected));
 }
 
 bool Calibrator::firstFrame(std::size_t& next) {
@@ -188,9 +190,7 @@ void Calibrator::rescore() {
   score_seconds_ = since(ts);
   score_points_ = 0;
   for (const auto& pair : score_pairs_) score_points_ += pair.source->size();
-  // The plan now leaves what the clock estimate after it is expected to take.
-  if (opt_.trajectory_clock)
-    deadline_ = earlierBy(share_, std::min(opt_.trajectory_clock_max_s, clockEstimateSeconds()));
+  reserveClockEstimate();  // from the score just timed
   best_score_ = samePose(best_, data_.T_mapping_calib_guess) ? initial_score_ : score(best_);
   if (!best_score_.betterThan(initial_score_)) {
     best_ = data_.T_mapping_calib_guess;

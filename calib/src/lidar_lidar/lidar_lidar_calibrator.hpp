@@ -81,9 +81,9 @@ class Calibrator {
   /// The best so far into out_ (result, scores, ok / failure, stage seconds).
   void publish();
 
-  /// What the trajectory clock estimate after the plan is expected to take, from the last score's time per
-  /// point (its passes cost about as much per point); 0 when it does not run.
-  [[nodiscard]] double clockEstimateSeconds() const;
+  /// The plan's deadline: the share less what the trajectory clock estimate after it is expected to take,
+  /// from the last score's time per point (`trajectory_clock_share` of the share until a score is timed).
+  void reserveClockEstimate();
 
   /// The deadline passed (or the run was cancelled): every step stops. Whether that cut the plan is run()'s
   /// call (out_.deadline_reached): the exhaustive pass at the end only fills the time left.

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <sstream>
+#include <utility>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -32,6 +33,14 @@ struct Pass {
   Matrix6d H = Matrix6d::Zero();
   Vector6d g = Vector6d::Zero();
   std::vector<double> frame_cost;  // Σ min(r², c²) per frame
+
+  Pass& operator+=(const Pass& o) {
+    H += o.H;
+    g += o.g;
+    frame_cost.resize(std::max(frame_cost.size(), o.frame_cost.size()), 0.0);
+    for (std::size_t k = 0; k < o.frame_cost.size(); ++k) frame_cost[k] += o.frame_cost[k];
+    return *this;
+  }
 };
 
 /// Point-to-plane residuals of every frame's points under D_k·T (D_k: the frame's mapping pose moved by
@@ -48,12 +57,14 @@ Pass linearise(std::vector<FrameData>& frames, const std::vector<Pose>& D, const
     for (std::size_t b = 0; b < frames[k].points.size(); b += kPiece)
       pieces.push_back({k, b, std::min(frames[k].points.size(), b + kPiece)});
   const double c2 = max_distance * max_distance;
-  std::vector<Pass> partial(pieces.size());
-  parallelFor(pieces.size(), num_threads, [&](std::size_t t) {
+  Pass init;
+  init.frame_cost.assign(frames.size(), 0.0);
+  return parallelReduce(pieces.size(), num_threads, std::move(init), [&](std::size_t t) {
     const Piece& piece = pieces[t];
     FrameData& f = frames[piece.frame];
-    Pass& pass = partial[t];
-    double cost = 0.0;
+    Pass pass;
+    pass.frame_cost.assign(piece.frame + 1, 0.0);
+    double& cost = pass.frame_cost[piece.frame];
     const Pose A = D[piece.frame] * T;
     const Eigen::Matrix3d At = A.linear().transpose();
     const auto& cloud = f.target->cloud();
@@ -81,16 +92,8 @@ Pass linearise(std::vector<FrameData>& frames, const std::vector<Pose>& D, const
       pass.H.noalias() += J * J.transpose();
       pass.g.noalias() += J * r;
     }
-    pass.frame_cost.assign(1, cost);
+    return pass;
   });
-  Pass pass;
-  pass.frame_cost.assign(frames.size(), 0.0);
-  for (std::size_t t = 0; t < pieces.size(); ++t) {
-    pass.H += partial[t].H;
-    pass.g += partial[t].g;
-    pass.frame_cost[pieces[t].frame] += partial[t].frame_cost[0];
-  }
-  return pass;
 }
 
 /// T moved by the Gauss-Newton step of `pass` (damped: the system is near-singular along what the frames
