@@ -19,26 +19,34 @@
 namespace rigcal::calib {
 namespace {
 
+// Two placements 100 m apart keep their cells a bit each; 30 km apart on every axis, in a hash set (a bit
+// each would take far more than its 8 MB bound). Both must hold the same cells around each placed point.
 TEST(SourceNeighbourhood, HoldsEveryPointWithinTheRadiusAndNothingFarBeyond) {
   registration::PointCloud source;
   source.points = {{0.0, 0.0, 0.0, 1.0}, {10.3, -4.7, 1.2, 1.0}};
-  const Pose shift(Eigen::Translation3d(100.0, 0.0, 0.0));
   const double radius = 0.6;
-  const SourceNeighbourhood near(source, {Pose::Identity(), shift}, radius);
-  for (const Pose& T : {Pose::Identity(), shift}) {
-    for (const auto& p : source.points) {
-      const Eigen::Vector3d c = T * p.head<3>();
-      // Points on a sphere just inside the radius around each placed source point are all held.
-      for (int i = 0; i < 200; ++i) {
-        const double z = -1.0 + 2.0 * (i + 0.5) / 200.0, a = 2.399963 * i;
-        const Eigen::Vector3d dir(std::sqrt(1 - z * z) * std::cos(a), std::sqrt(1 - z * z) * std::sin(a), z);
-        EXPECT_TRUE(near.contains(c + 0.999 * radius * dir)) << "around " << c.transpose();
-        EXPECT_FALSE(near.contains(c + 2.0 * std::sqrt(3.0) * radius * 1.001 * dir)) << "around " << c.transpose();
+  for (const Eigen::Vector3d& offset : {Eigen::Vector3d(100.0, 0.0, 0.0), Eigen::Vector3d(3e4, -3e4, 3e4)}) {
+    const Pose shift(Eigen::Translation3d{offset});
+    const SourceNeighbourhood near(source, {Pose::Identity(), shift}, radius);
+    EXPECT_LE(near.cells(), 2u * 2u * 27u);
+    EXPECT_GE(near.cells(), 2u * 27u);
+    for (const Pose& T : {Pose::Identity(), shift}) {
+      for (const auto& p : source.points) {
+        const Eigen::Vector3d c = T * p.head<3>();
+        // Points on a sphere just inside the radius around each placed source point are all held.
+        for (int i = 0; i < 200; ++i) {
+          const double z = -1.0 + 2.0 * (i + 0.5) / 200.0, a = 2.399963 * i;
+          const Eigen::Vector3d dir(std::sqrt(1 - z * z) * std::cos(a), std::sqrt(1 - z * z) * std::sin(a), z);
+          EXPECT_TRUE(near.contains(c + 0.999 * radius * dir)) << "around " << c.transpose();
+          EXPECT_FALSE(near.contains(c + 2.0 * std::sqrt(3.0) * radius * 1.001 * dir)) << "around " << c.transpose();
+        }
       }
     }
+    EXPECT_FALSE(near.contains(offset / 2.0));
+    EXPECT_FALSE(near.contains({NAN, 0.0, 0.0}));
+    EXPECT_FALSE(near.contains({1e300, 0.0, 0.0}));
   }
-  EXPECT_FALSE(near.contains({50.0, 0.0, 0.0}));
-  EXPECT_FALSE(near.contains({NAN, 0.0, 0.0}));
+  EXPECT_FALSE(SourceNeighbourhood(registration::PointCloud{}, {Pose::Identity()}, radius).contains({0.0, 0.0, 0.0}));
   EXPECT_THROW(SourceNeighbourhood(source, {Pose::Identity()}, 0.0), std::invalid_argument);
 }
 
