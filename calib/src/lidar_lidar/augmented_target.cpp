@@ -64,13 +64,21 @@ double nearTargetRadius(const config::Parameters& params) {
   return std::max(params.max_corr_dist_coarse, params.calibration_eval_max_corr_distance) + kEstimateError;
 }
 
-registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& dataset, std::size_t frame,
-                                        const registration::PointCloud& source, const config::Parameters& params,
-                                        const AugmentedTargetOptions& options, std::size_t* clouds_used,
+TargetWindowClouds targetWindowClouds(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                      const config::Parameters& params, std::size_t max_clouds) {
+  TargetWindowClouds window;
+  for (const std::size_t i : targetWindow(dataset, frame, params, max_clouds))
+    window.clouds.push_back(dataset.mapping_clouds[i]);
+  window.T_scan_map = dataset.frames[frame].pairing.T_map_mapping_at_scan.inverse();
+  window.T_mapping_calib_guess = dataset.T_mapping_calib_guess;
+  return window;
+}
+
+registration::PointCloud augmentedCloud(const TargetWindowClouds& window, const registration::PointCloud& source,
+                                        const config::Parameters& params, const AugmentedTargetOptions& options,
                                         std::size_t* points_before_voxel) {
-  const auto window = targetWindow(dataset, frame, params, options.max_clouds);
   // Crop box: the source under the initial extrinsic, widened by |t_initial| (the guess may be that far off).
-  const Pose& guess = dataset.T_mapping_calib_guess;
+  const Pose& guess = window.T_mapping_calib_guess;
   Eigen::Vector3d box_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d box_max = -box_min;
   for (const auto& p : source.points) {
@@ -88,15 +96,14 @@ registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& data
     return (q.array() >= box_min.array()).all() && (q.array() <= box_max.array()).all();
   };
 
-  const Pose T_scan_map = dataset.frames[frame].pairing.T_map_mapping_at_scan.inverse();
   // Each cloud is cropped and voxelised before the next (the same centroids as voxelising the whole crop
   // at once), so the deadline is looked at between clouds for all of the work.
   std::optional<registration::VoxelAccumulator> voxels;
   std::vector<Eigen::Vector4d> cropped;
-  for (const std::size_t i : window) {
+  for (const auto& mc : window.clouds) {
     if (options.deadline.expired()) return {};
-    const auto& mc = dataset.mapping_clouds[i];
-    const Eigen::Matrix4f T = (T_scan_map * mc.frame.T_map_lidar).matrix().cast<float>();
+    if (mc.cloud == nullptr) continue;
+    const Eigen::Matrix4f T = (window.T_scan_map * mc.frame.T_map_lidar).matrix().cast<float>();
     const Scan& s = *mc.cloud;
     cropped.clear();
     for (std::size_t j = 0; j < s.size(); ++j) {
@@ -106,13 +113,21 @@ registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& data
       cropped.emplace_back(qd.x(), qd.y(), qd.z(), 1.0);
     }
     if (cropped.empty()) continue;
-    if (!voxels) voxels.emplace(params.leaf_size_dense_map, cropped.size() * window.size());
+    if (!voxels) voxels.emplace(params.leaf_size_dense_map, cropped.size() * window.clouds.size());
     voxels->add(cropped);
   }
-  if (clouds_used != nullptr) *clouds_used = window.size();
   if (points_before_voxel != nullptr) *points_before_voxel = voxels ? voxels->added() : 0;
   if (!voxels) return {};
   return voxels->centroids();
+}
+
+registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                        const registration::PointCloud& source, const config::Parameters& params,
+                                        const AugmentedTargetOptions& options, std::size_t* clouds_used,
+                                        std::size_t* points_before_voxel) {
+  const auto window = targetWindowClouds(dataset, frame, params, options.max_clouds);
+  if (clouds_used != nullptr) *clouds_used = window.clouds.size();
+  return augmentedCloud(window, source, params, options, points_before_voxel);
 }
 
 AugmentedTarget buildAugmentedTarget(const pipeline::CalibrationDataset& dataset, std::size_t frame,

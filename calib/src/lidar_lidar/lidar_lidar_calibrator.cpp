@@ -130,6 +130,7 @@ bool Calibrator::laterTargets(std::size_t& next, std::size_t first_frames) {
     seconds_.ensemble += since(t);
     t = Clock::now();
   }
+  prefetch_.abandon();  // a frame prepared ahead that will not be built
   seconds_.targets += since(t);
   return targets_cut;
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rigcal/calib/lidar_lidar/calibration_score.hpp"
+#include "rigcal/calib/lidar_lidar/frame_preparation.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 
 namespace rigcal::calib::detail {
@@ -93,6 +94,11 @@ class Calibrator {
   /// Out of time when the target's build would leave less than `reserve` seconds.
   FrameBuild buildFrame(std::size_t i, double reserve = 0.0);
   FrameBuild buildFrameTarget(std::size_t i, double reserve);  // buildFrame's work, before the clouds' release
+  /// The augmented target's options for the next frame built: near the best once it moved from the guess.
+  [[nodiscard]] AugmentedTargetOptions targetOptions() const;
+  /// What preparing frame i reads, held (the crop may run on another thread).
+  [[nodiscard]] FramePreparationInputs preparationInputs(std::size_t i, int num_threads) const;
+  [[nodiscard]] std::size_t minSourcePoints() const;
 
   /// The initial guess's and the best's scores over the frames built so far (the set just grew).
   void rescore();
@@ -158,6 +164,7 @@ class Calibrator {
   bool redeskewed_ = false;  // the sources were re-deskewed with the best extrinsic (finalStep)
   Pose best_ = Pose::Identity();
   CalibrationScore best_score_;
+  FramePrefetch prefetch_;  // the next later frame's source and crop (last member: joined first)
 };
 
 }  // namespace rigcal::calib::detail

@@ -4,11 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "rigcal/calib/lidar_lidar/augmented_target.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
-#include "rigcal/calib/lidar_lidar/calibration_source.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
 
 namespace rigcal::calib::detail {
@@ -36,25 +36,7 @@ FrameBuild Calibrator::buildFrame(std::size_t i, double reserve) {
   return built;
 }
 
-FrameBuild Calibrator::buildFrameTarget(std::size_t i, double reserve) {
-  const auto& df = data_.frames[i];
-  std::ostringstream skip;
-  skip << "frame " << i << ": ";
-  const auto tb = Clock::now();
-  Frame f;
-  f.index = i;
-  SourceOptions so;
-  so.covariances = false;  // GICP's, estimated when a GICP first runs on the frame (ensureSourceCovariances)
-  so.num_threads = opt_.num_threads;
-  f.source = buildSource(*df.deskewed, params_, so);
-  // Every step of a frame's preparation that cannot be interrupted is followed by a look at the deadline.
-  if (stopped()) return FrameBuild::kOutOfTime;
-  if (f.source.size() < std::size_t(std::max(params_.min_calibration_pointcloud_size, 10))) {
-    skip << f.source.size() << " source points within the calibration range (min_calibration_pointcloud_size "
-         << params_.min_calibration_pointcloud_size << ")";
-    out_.frames_skipped.push_back(skip.str());
-    return FrameBuild::kSkipped;
-  }
+AugmentedTargetOptions Calibrator::targetOptions() const {
   AugmentedTargetOptions to = opt_.target;
   to.num_threads = opt_.num_threads;
   to.deadline = deadline_;
@@ -65,14 +47,48 @@ FrameBuild Calibrator::buildFrameTarget(std::size_t i, double reserve) {
     to.near_poses = {data_.T_mapping_calib_guess, best_};
     to.near_radius = nearTargetRadius(params_);
   }
-  std::size_t clouds = 0, cropped = 0;
-  const auto tc = Clock::now();
-  auto cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds, &cropped);
-  if (stopped()) return FrameBuild::kOutOfTime;
+  return to;
+}
+
+FramePreparationInputs Calibrator::preparationInputs(std::size_t i, int num_threads) const {
+  FramePreparationInputs in;
+  in.index = i;
+  in.deskewed = data_.frames[i].deskewed;
+  in.target = targetOptions();
+  in.window = targetWindowClouds(data_, i, params_, in.target.max_clouds);
+  in.num_threads = num_threads;
+  return in;
+}
+
+std::size_t Calibrator::minSourcePoints() const {
+  return std::size_t(std::max(params_.min_calibration_pointcloud_size, 10));
+}
+
+FrameBuild Calibrator::buildFrameTarget(std::size_t i, double reserve) {
+  std::ostringstream skip;
+  skip << "frame " << i << ": ";
+  // Prepared on the second core while the previous frame's target was built and confirmed, or now.
+  std::optional<PreparedFrame> prefetched = prefetch_.take(i);
+  PreparedFrame p = prefetched ? std::move(*prefetched)
+                               : prepareFrame(preparationInputs(i, opt_.num_threads), params_, minSourcePoints());
+  const auto tp = Clock::now();
+  // Every step of a frame's preparation that cannot be interrupted is followed by a look at the deadline.
+  if (p.out_of_time || stopped()) return FrameBuild::kOutOfTime;
+  if (p.source.size() < minSourcePoints()) {
+    skip << p.source.size() << " source points within the calibration range (min_calibration_pointcloud_size "
+         << params_.min_calibration_pointcloud_size << ")";
+    out_.frames_skipped.push_back(skip.str());
+    return FrameBuild::kSkipped;
+  }
+  Frame f;
+  f.index = i;
+  f.source = std::move(p.source);
+  auto cloud = std::move(p.cloud);
+  std::size_t clouds = p.clouds;
   // What the first frame still needs (perhaps a voxel pass over these points, a target build over them, a
   // registration) takes longer than the crop did: with less time left, stop now rather than start an uncut
   // voxel pass that overshoots the deadline (a 0.5 s share ended 0.1-0.18 s late on a loaded machine).
-  if (frames_.empty() && !fits(deadline_, since(tc))) return FrameBuild::kOutOfTime;
+  if (frames_.empty() && !fits(deadline_, p.crop_seconds)) return FrameBuild::kOutOfTime;
   // The first frame must leave time to register: under a short deadline its target is thinned rather
   // than not built at all. First by coarser voxels over every mapping cloud of the window: dropping clouds
   // (below) leaves holes where no remaining cloud looked, and a tilted lidar looks where a 32-beam map has
@@ -85,25 +101,31 @@ FrameBuild Calibrator::buildFrameTarget(std::size_t i, double reserve) {
     if (leaf > params_.leaf_size_dense_map) cloud = registration::voxelDownsample(cloud, leaf);
   }
   if (frames_.empty() && clouds > 1 && seconds_per_point_ * double(cloud.size()) > allowed) {
+    AugmentedTargetOptions to = targetOptions();
     const double points_per_cloud = double(dense_points) / double(clouds);  // the rebuild is at the dense leaf
     to.max_clouds = std::max<std::size_t>(1, std::size_t(allowed / (seconds_per_point_ * points_per_cloud)));
-    cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds, &cropped);
+    cloud = augmentedCloud(data_, i, f.source, params_, to, &clouds);
     if (stopped()) return FrameBuild::kOutOfTime;
   }
   // Do not start a build that the deadline would cut (wasted work: the build stops at the deadline), nor
   // one that leaves less than `reserve`. Judged on the cropped cloud: a later frame's near crop is a
   // fraction of the first frame's box (the street's VLP-16 behind a VLS-128 map).
-  const double prepare_seconds = since(tb);
+  const double prepare_seconds = p.source_seconds + p.crop_seconds + since(tp);
   if (!fits(deadline_, seconds_per_point_ * double(cloud.size()) + reserve)) return FrameBuild::kOutOfTime;
   if (cloud.size() < 100) {
     skip << "augmented target has " << cloud.size() << " points from " << clouds << " mapping clouds";
     out_.frames_skipped.push_back(skip.str());
     return FrameBuild::kSkipped;
   }
+  // A later frame's build and confirmation leave the second core idle for stretches: the next frame's source
+  // and crop (single-threaded) go there. Its crop is near the best as it stands now, one confirmation older
+  // than the frame's own build would see: the near radius allows for that (nearTargetRadius).
+  if (!frames_.empty() && opt_.num_threads > 1 && i + 1 < data_.frames.size())
+    prefetch_.start(preparationInputs(i + 1, 1), params_, minSourcePoints());
   const double n = double(cloud.size());
   registration::TargetOptions topt;
   topt.normals_and_covariances = true;
-  topt.ndt_resolutions = {to.ndt_resolution};
+  topt.ndt_resolutions = {opt_.target.ndt_resolution};
   topt.num_threads = opt_.num_threads;
   topt.deadline = deadline_;  // on a busy machine a build can take several times its estimate
   const auto tt = Clock::now();

@@ -56,8 +56,25 @@ struct AugmentedTarget {
 std::vector<std::size_t> targetWindow(const pipeline::CalibrationDataset& dataset, std::size_t frame,
                                       const config::Parameters& params, std::size_t max_clouds);
 
-/// The augmented cloud of dataset.frames[frame] (before building the Target), cropped around `source`
-/// placed by the dataset's initial extrinsic (or near it under options.near_poses). Empty when options.deadline expired during the crop.
+/// The mapping clouds of a frame's target window (targetWindow()), held: the dataset may let go of its own
+/// references (calibrateLidarLidarDroppingClouds) while a crop of these runs on another thread.
+struct TargetWindowClouds {
+  std::vector<pipeline::MappingCloud> clouds;
+  Pose T_scan_map = Pose::Identity();  // the map into the mapping-lidar frame at the calibration scan's stamp
+  Pose T_mapping_calib_guess = Pose::Identity();
+};
+
+TargetWindowClouds targetWindowClouds(const pipeline::CalibrationDataset& dataset, std::size_t frame,
+                                      const config::Parameters& params, std::size_t max_clouds);
+
+/// The augmented cloud of a window (before building the Target), cropped around `source` placed by the
+/// initial extrinsic (or near it under options.near_poses). Empty when options.deadline expired during the
+/// crop. Reads nothing but its arguments: safe on a thread of its own.
+registration::PointCloud augmentedCloud(const TargetWindowClouds& window, const registration::PointCloud& source,
+                                        const config::Parameters& params, const AugmentedTargetOptions& options,
+                                        std::size_t* points_before_voxel = nullptr);
+
+/// The same for dataset.frames[frame] (its window picked with options.max_clouds).
 registration::PointCloud augmentedCloud(const pipeline::CalibrationDataset& dataset, std::size_t frame,
                                         const registration::PointCloud& source, const config::Parameters& params,
                                         const AugmentedTargetOptions& options, std::size_t* clouds_used = nullptr,
