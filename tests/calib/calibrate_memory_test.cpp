@@ -69,15 +69,17 @@ ChildUsage calibrateParkingLot(const TempDir& dir, const std::vector<std::string
 }
 
 // A 12 s drive of the demo's scenario (two VLP-16 calibration lidars, a 64-beam mapping lidar): its peak
-// RSS stays under a bound the code before keyframe-only target clouds exceeded (238 MB measured, quiet) and
-// the code since meets (199 MB quiet, up to 215 MB at load 8). Release only: sanitizers and debug builds
-// allocate differently.
+// RSS stays under a bound that catches the regression keyframe-only target clouds fixed (+39 MB: 238 MB
+// against 199 MB, quiet). Since the next frame's crop is prepared beside the current target's build (one
+// more crop and voxel map alive at once) it measures 202-230 MB quiet (median 211 in 13 runs; main before
+// it 195-218, median 205), so the bound is 250 MB. Release only: sanitizers and debug builds allocate
+// differently.
 TEST(CalibrateMemory, PeakRssOfAShortDriveStaysBounded) {
 #ifndef NDEBUG
   GTEST_SKIP() << "peak memory is asserted in optimised builds only";
 #endif
   if (kSanitized) GTEST_SKIP() << "peak memory is asserted in uninstrumented builds only";
-  constexpr long kBoundKb = 235 * 1024;
+  constexpr long kBoundKb = 250 * 1024;
   TempDir dir;
   // A short deadline: the calibration's targets are part of the peak, and the test stays short.
   const ChildUsage u = calibrateParkingLot(dir, {"--duration", "12"}, {"--deadline", "2"});
