@@ -33,8 +33,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// A copy of `pcap` (Ethernet, classic pcap) in which `count` Velodyne data packets from a quarter of the
-/// way in have their first block header zeroed: the decoder drops each one as malformed.
+/// A copy of `pcap` (Ethernet, classic pcap) in which `count` Velodyne data packets from three quarters of
+/// the way in have their first block header zeroed: the decoder drops each one as malformed.
 fs::path withMalformedPackets(const fs::path& pcap, const fs::path& out, int count) {
   std::ifstream in(pcap, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -46,8 +46,10 @@ fs::path withMalformedPackets(const fs::path& pcap, const fs::path& out, int cou
     if (captured == kEthIpUdp + kDataPayload) payloads.push_back(at + kRecordHeader + kEthIpUdp);
     at += kRecordHeader + captured;
   }
+  // Three quarters into the capture: a reader counts what its ring carried from the first scan it read on,
+  // and a reader attaches up to a poll (100 ms) after the ring appears, later on a busy machine.
   for (int i = 0; i < count; ++i) {
-    const std::size_t at = payloads.at(payloads.size() / 4 + std::size_t(i) * 3);
+    const std::size_t at = payloads.at(payloads.size() * 3 / 4 + std::size_t(i) * 3);
     bytes[at] = bytes[at + 1] = 0;  // block 0's 0xFFEE
   }
   std::ofstream(out, std::ios::binary) << bytes;
@@ -273,7 +275,10 @@ TEST_F(TrustRing, CalibrateReportsTheMalformedPacketsOfADriverProcess) {
   RigcalProcess calibrate({"calibrate", "--config", rig.string(), "--shm", "--shm-prefix", prefix_, "--out",
                            out.string()});
   std::vector<std::string> roof = driverArgs(pcap, "64"), left = driverArgs(damaged, "64");
-  roof[8] = left[8] = "1";
+  roof[8] = "1";
+  // Half speed: the damaged packets come ~0.5 s after the left ring appears, long after calibrate's reader
+  // attached (once, at load, it attached after them and counted 1 of 4).
+  left[8] = "0.5";
   left[2] = left_rig.string();
   left[4] = "left";
   RigcalProcess roof_driver(roof), left_driver(left);
