@@ -121,9 +121,10 @@ std::optional<std::string> FrameTracker::keyframeLostReason(const MappingFrame& 
   const MappingFrame& kf = frames_[keyframes_.back()];
   // The keyframe-lost check looks for a registration jump. A turn is not one: on a turn the direction of
   // travel changes with the vehicle's heading, and between keyframes a metre apart a robot's 2-3 m radius
-  // turns it by 20-30° (yard-side: 28°, its 15 keyframes around that turn all dropped as lost). So both
-  // tests follow the vehicle's own motion: the travel direction is compared as the vehicle sees it, and
-  // the frames between two keyframes must lie on the screw motion between them (an arc on a turn).
+  // turns it by 20-30° (yard-side: 28°; its two keyframes there called lost took 15 of a side lidar's 50
+  // calibration candidates with them). So both tests follow the vehicle's own motion: the travel direction
+  // is compared as the vehicle sees it, and the frames between two keyframes must lie on the screw motion
+  // between them (an arc on a turn).
   if (keyframes_.size() >= 2) {
     const MappingFrame& kf_prev = frames_[keyframes_[keyframes_.size() - 2]];
     const Eigen::Vector3d d1 = kf.T_map_lidar.translation() - kf_prev.T_map_lidar.translation();
