@@ -98,7 +98,8 @@ class LidarLidarMounts : public ::testing::TestWithParam<const char*> {};
 //                 ratio 0.28-0.30 and frames 24 cm apart. A sideways lidar looks at the strip beside the vehicle
 //                 that the roof lidar's blind circle hides on a straight drive. These 10 s hold the side rig to
 //                 an honest verdict (never ok when off the goal), the corners to the goal; the whole drive, turns
-//                 included, puts every lidar of both rigs within the goal (calibrate_yard_test.cpp, long).
+//                 included, put every lidar of both rigs within the goal, quiet and beside one busy loop
+//                 (calibrate_yard_test.cpp, long).
 TEST_P(LidarLidarMounts, EveryCalibrationLidarWithinTheGoalFromAThirtyCentimetreFiveDegreeGuess) {
   // Whole calibrations without a deadline: minutes under the sanitizers, which see the same code paths in
   // rigcal_lidar_lidar_tests.
