@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Geometry>
-
 namespace rigcal::pipeline {
 
 const char* toString(FrameKind kind) {
@@ -110,13 +108,6 @@ MappingFrame FrameTracker::add(std::uint64_t sequence, TimeNs stamp_ns, const Po
   return f;
 }
 
-namespace {
-/// The orientation halfway between two poses.
-Eigen::Matrix3d midRotation(const Pose& a, const Pose& b) {
-  return Eigen::Quaterniond(a.rotation()).slerp(0.5, Eigen::Quaterniond(b.rotation())).toRotationMatrix();
-}
-}  // namespace
-
 std::optional<std::string> FrameTracker::keyframeLostReason(const MappingFrame& candidate) const {
   const MappingFrame& kf = frames_[keyframes_.back()];
   // The keyframe-lost check looks for a registration jump. A turn is not one: on a turn the direction of
@@ -134,8 +125,10 @@ std::optional<std::string> FrameTracker::keyframeLostReason(const MappingFrame& 
     if (d1.norm() > min_travel && d2.norm() > min_travel) {
       // Each stretch's direction in the vehicle's frame halfway along it: constant on a turn of constant
       // radius, whatever the radius, and on a straight.
-      const Eigen::Vector3d v1 = midRotation(kf_prev.T_map_lidar, kf.T_map_lidar).transpose() * d1;
-      const Eigen::Vector3d v2 = midRotation(kf.T_map_lidar, candidate.T_map_lidar).transpose() * d2;
+      const Eigen::Vector3d v1 =
+          interpolateLerpSlerp(kf_prev.T_map_lidar, kf.T_map_lidar, 0.5).linear().transpose() * d1;
+      const Eigen::Vector3d v2 =
+          interpolateLerpSlerp(kf.T_map_lidar, candidate.T_map_lidar, 0.5).linear().transpose() * d2;
       double angle = rad2deg(std::acos(std::clamp(v1.normalized().dot(v2.normalized()), -1.0, 1.0)));
       // From rest a vehicle may set off backwards along the line it came (a car changes gear at rest):
       // after a stopped keyframe only the line of travel must hold, not its sense.
@@ -148,10 +141,10 @@ std::optional<std::string> FrameTracker::keyframeLostReason(const MappingFrame& 
   // length, not time: by time, every start from a stop (the speed changes between the keyframes) would be
   // "lost".
   const double span = candidate.path_length - kf.path_length;
-  const Vector6d motion = logSE3(kf.T_map_lidar.inverse() * candidate.T_map_lidar);
   for (std::size_t i = keyframes_.back() + 1; i < frames_.size() && span > 0; ++i) {
     const MappingFrame& mid = frames_[i];
-    const Pose expected = kf.T_map_lidar * expSE3((mid.path_length - kf.path_length) / span * motion);
+    const Pose expected =
+        interpolateGeodesic(kf.T_map_lidar, candidate.T_map_lidar, (mid.path_length - kf.path_length) / span);
     const double error = (expected.translation() - mid.T_map_lidar.translation()).norm();
     if (error > params_.lost_frame_interpolation_error)
       return "frame " + std::to_string(mid.sequence) + " is " + std::to_string(error) +
