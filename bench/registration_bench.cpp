@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "registration_bench_data.hpp"
 #include "registration_profile.hpp"
@@ -28,6 +29,7 @@
 #include "rigcal/registration/icp.hpp"
 #include "rigcal/registration/ndt.hpp"
 #include "rigcal/registration/voxel_grid.hpp"
+#include "rigcal/registration/voxel_ordered_cloud.hpp"
 
 namespace {
 
@@ -191,6 +193,51 @@ void pclVoxel(benchmark::State& state, double leaf) {
   state.counters["points_out"] = static_cast<double>(out.size());
 }
 
+// The mapper's local map at each keyframe: 15 keyframes (the VLS-128 scan voxelised at 0.1 m, placed 1 m
+// apart as a drive places them) voxelised together at 0.1 m in the map frame. Ours: each keyframe ordered by
+// voxel once when it is added, the orders merged at each rebuild; the baseline (what the mapper did before,
+// the same points bit for bit): voxelDownsample's hashed pass over the concatenated keyframes.
+constexpr int kLocalMapKeyframes = 15;
+constexpr double kLocalMapLeaf = 0.1;
+std::vector<PointCloud> placedKeyframes() {
+  const PointCloud scan = voxelDownsample(data().raw, kLocalMapLeaf);
+  std::vector<PointCloud> keyframes;
+  for (int k = 0; k < kLocalMapKeyframes; ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.rotate(Eigen::AngleAxisd(0.01 * k, Eigen::Vector3d::UnitZ()));
+    T.pretranslate(Eigen::Vector3d(1.0 * k, 0.02 * k, 0.0));
+    keyframes.push_back(transformed(scan, T));
+  }
+  return keyframes;
+}
+void localMapMerge(benchmark::State& state) {
+  std::vector<VoxelOrderedCloud> ordered;
+  for (const PointCloud& k : placedKeyframes()) {
+    std::vector<Eigen::Vector3d> points;
+    for (const auto& p : k.points) points.push_back(p.head<3>());
+    ordered.emplace_back(std::move(points), kLocalMapLeaf);
+  }
+  std::vector<const VoxelOrderedCloud*> clouds;
+  for (const auto& k : ordered) clouds.push_back(&k);
+  std::size_t n = 0;
+  for (auto _ : state) n = voxelDownsampleConcatenation(clouds, kLocalMapLeaf).size();
+  state.counters["points_out"] = static_cast<double>(n);
+}
+void localMapVoxelPass(benchmark::State& state) {
+  PointCloud all;
+  for (const PointCloud& k : placedKeyframes()) all.points.insert(all.points.end(), k.points.begin(), k.points.end());
+  std::size_t n = 0;
+  for (auto _ : state) n = voxelDownsample(all, kLocalMapLeaf).size();
+  state.counters["points_out"] = static_cast<double>(n);
+}
+// What ordering one keyframe costs when it is added (once per keyframe, against ~15 rebuilds it is in).
+void localMapOrderKeyframe(benchmark::State& state) {
+  const PointCloud k = placedKeyframes().back();
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& p : k.points) points.push_back(p.head<3>());
+  for (auto _ : state) benchmark::DoNotOptimize(VoxelOrderedCloud(points, kLocalMapLeaf).byVoxel().size());
+}
+
 void oursTarget(benchmark::State& state, const Scenario* s) {
   TargetOptions options;
   options.normals_and_covariances = true;
@@ -286,6 +333,12 @@ void printTable() {
     std::printf("%-22s | %6.2f (%6.2f) / %6.2f | %6.2f (%6.2f) / %6.2f | %7.1fx\n", block, ours.median,
                 ours.median_cpu, ours.p99, theirs.median, theirs.median_cpu, theirs.p99, theirs.median / ours.median);
   }
+  const Row merge = get("local-map/merge"), pass = get("local-map/voxel-pass"), order = get("local-map/order-keyframe");
+  std::printf("\nlocal map (%d keyframes at %.1f m): merge of the keyframes' voxel orders %.2f / %.2f ms (median / "
+              "p99), hashed voxel pass over the concatenation %.2f / %.2f ms: %.1fx; ordering a keyframe once %.2f / "
+              "%.2f ms\n",
+              kLocalMapKeyframes, kLocalMapLeaf, merge.median, merge.p99, pass.median, pass.p99,
+              pass.median / merge.median, order.median, order.p99);
 }
 
 }  // namespace
@@ -338,6 +391,9 @@ int main(int argc, char** argv) {
     stats(benchmark::RegisterBenchmark((n + "ours").c_str(), oursVoxel, leaf), 10);
     stats(benchmark::RegisterBenchmark((n + "pcl").c_str(), pclVoxel, leaf), 10);
   }
+  stats(benchmark::RegisterBenchmark("local-map/merge", localMapMerge), 10);
+  stats(benchmark::RegisterBenchmark("local-map/order-keyframe", localMapOrderKeyframe), 10);
+  stats(benchmark::RegisterBenchmark("local-map/voxel-pass", localMapVoxelPass), 10);
   TableReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   printTable();

@@ -14,22 +14,19 @@ namespace reg = registration;
 
 namespace {
 
-/// The keyframes' points one after the other, homogeneous again (w = 1, as they were transformed).
+/// voxelDownsample of the keyframes' points one after the other, by merging their voxel orders (bit for bit).
 template <class Clouds>
-reg::PointCloud concatenated(const Clouds& clouds) {
-  std::size_t n = 0;
-  for (const auto& k : clouds) n += k->size();
-  reg::PointCloud merged;
-  merged.points.reserve(n);
-  for (const auto& k : clouds)
-    for (const Eigen::Vector3d& p : *k) merged.points.emplace_back(p.x(), p.y(), p.z(), 1.0);
-  return merged;
+reg::PointCloud voxelised(const Clouds& clouds, double leaf) {
+  std::vector<const reg::VoxelOrderedCloud*> keyframes;
+  keyframes.reserve(clouds.size());
+  for (const auto& k : clouds) keyframes.push_back(k.get());
+  return reg::voxelDownsampleConcatenation(keyframes, leaf);
 }
 
 template <class Clouds>
 std::shared_ptr<const reg::Target> buildTarget(const Clouds& clouds, const config::Parameters& params, bool use_ndt,
                                                int threads) {
-  reg::PointCloud merged = reg::voxelDownsample(concatenated(clouds), params.leaf_size_local_map);
+  reg::PointCloud merged = voxelised(clouds, params.leaf_size_local_map);
   reg::TargetOptions o;
   o.num_threads = threads;
   if (use_ndt) o.ndt_resolutions = {params.mapper_resolution};
@@ -62,9 +59,10 @@ void LocalMap::swapInPendingTarget(bool now) {
 void LocalMap::addKeyframe(const Scan& deskewed, const Pose& T_map_lidar, bool restart) {
   const reg::PointCloud c =
       reg::transformed(reg::voxelDownsample(reg::fromScan(deskewed), params_.leaf_size_local_map), T_map_lidar);
-  auto k = std::make_shared<std::vector<Eigen::Vector3d>>();
-  k->reserve(c.size());
-  for (const auto& p : c.points) k->push_back(p.head<3>());
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(c.size());
+  for (const auto& p : c.points) points.push_back(p.head<3>());
+  auto k = std::make_shared<const reg::VoxelOrderedCloud>(points, params_.leaf_size_local_map);
   if (restart) local_.clear();
   all_keyframes_.push_back(k);
   local_.push_back(std::move(k));
@@ -103,6 +101,6 @@ void LocalMap::launchBuild() {
   });
 }
 
-reg::PointCloud LocalMap::allKeyframes() const { return concatenated(all_keyframes_); }
+reg::PointCloud LocalMap::allKeyframes() const { return voxelised(all_keyframes_, params_.leaf_size_local_map); }
 
 }  // namespace rigcal::pipeline

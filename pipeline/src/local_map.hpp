@@ -15,6 +15,7 @@
 #include "rigcal/core/scan.hpp"
 #include "rigcal/registration/point_cloud.hpp"
 #include "rigcal/registration/target.hpp"
+#include "rigcal/registration/voxel_ordered_cloud.hpp"
 
 namespace rigcal::pipeline {
 
@@ -31,13 +32,15 @@ class LocalMap {
   /// Adds a keyframe (`deskewed` in the lidar frame at T_map_lidar); `restart` drops the older ones first.
   void addKeyframe(const Scan& deskewed, const Pose& T_map_lidar, bool restart);
 
-  /// Every keyframe ever added, merged (map frame, voxel leaf_size_local_map per keyframe).
+  /// Every keyframe ever added, voxelised together at leaf_size_local_map (map frame): the drive's map.
   [[nodiscard]] registration::PointCloud allKeyframes() const;
 
  private:
   /// A keyframe's voxelised cloud in the map frame: positions only, without the homogeneous w (always 1),
-  /// three quarters of a PointCloud's bytes; a drive keeps every keyframe for the map (issue #18).
-  using KeyframeCloud = std::shared_ptr<const std::vector<Eigen::Vector3d>>;
+  /// three quarters of a PointCloud's bytes; a drive keeps every keyframe for the map (issue #18). With its
+  /// points' order by map voxel (4 bytes a point), so that each rebuild merges the keyframes' orders instead
+  /// of hashing every point of the local map again (the same map, bit for bit).
+  using KeyframeCloud = std::shared_ptr<const registration::VoxelOrderedCloud>;
 
   void swapInPendingTarget(bool now);
   void launchBuild();

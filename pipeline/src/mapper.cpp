@@ -266,7 +266,7 @@ std::shared_ptr<const Scan> Mapper::mapCloud() const {
   Scan like;
   like.sensor_id = "map";
   if (merged.empty()) return std::make_shared<const Scan>(like);
-  return std::make_shared<const Scan>(reg::toScan(reg::voxelDownsample(merged, impl_->params.leaf_size_local_map), like));
+  return std::make_shared<const Scan>(reg::toScan(merged, like));
 }
 
 }  // namespace rigcal::pipeline
