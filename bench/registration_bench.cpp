@@ -212,11 +212,7 @@ std::vector<PointCloud> placedKeyframes() {
 }
 void localMapMerge(benchmark::State& state) {
   std::vector<VoxelOrderedCloud> ordered;
-  for (const PointCloud& k : placedKeyframes()) {
-    std::vector<Eigen::Vector3d> points;
-    for (const auto& p : k.points) points.push_back(p.head<3>());
-    ordered.emplace_back(std::move(points), kLocalMapLeaf);
-  }
+  for (const PointCloud& k : placedKeyframes()) ordered.emplace_back(k, kLocalMapLeaf);
   std::vector<const VoxelOrderedCloud*> clouds;
   for (const auto& k : ordered) clouds.push_back(&k);
   std::size_t n = 0;
@@ -233,9 +229,7 @@ void localMapVoxelPass(benchmark::State& state) {
 // What ordering one keyframe costs when it is added (once per keyframe, against ~15 rebuilds it is in).
 void localMapOrderKeyframe(benchmark::State& state) {
   const PointCloud k = placedKeyframes().back();
-  std::vector<Eigen::Vector3d> points;
-  for (const auto& p : k.points) points.push_back(p.head<3>());
-  for (auto _ : state) benchmark::DoNotOptimize(VoxelOrderedCloud(points, kLocalMapLeaf).byVoxel().size());
+  for (auto _ : state) benchmark::DoNotOptimize(VoxelOrderedCloud(k, kLocalMapLeaf).byVoxel().size());
 }
 
 void oursTarget(benchmark::State& state, const Scenario* s) {

@@ -57,12 +57,9 @@ void LocalMap::swapInPendingTarget(bool now) {
 }
 
 void LocalMap::addKeyframe(const Scan& deskewed, const Pose& T_map_lidar, bool restart) {
-  const reg::PointCloud c =
-      reg::transformed(reg::voxelDownsample(reg::fromScan(deskewed), params_.leaf_size_local_map), T_map_lidar);
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(c.size());
-  for (const auto& p : c.points) points.push_back(p.head<3>());
-  auto k = std::make_shared<const reg::VoxelOrderedCloud>(points, params_.leaf_size_local_map);
+  auto k = std::make_shared<const reg::VoxelOrderedCloud>(
+      reg::transformed(reg::voxelDownsample(reg::fromScan(deskewed), params_.leaf_size_local_map), T_map_lidar),
+      params_.leaf_size_local_map);
   if (restart) local_.clear();
   all_keyframes_.push_back(k);
   local_.push_back(std::move(k));

@@ -19,8 +19,8 @@ void checkLeaf(double leaf, const char* who) {
 }
 
 /// voxelDownsample's voxel of p (false where it drops p).
-bool voxelOf(const Eigen::Vector3d& p, double inv_leaf, detail::VoxelCoord* c) {
-  return p.allFinite() && detail::voxelCoord(Eigen::Vector4d(p.x(), p.y(), p.z(), 1.0), inv_leaf, c);
+bool voxelOf(const Eigen::Vector4d& p, double inv_leaf, detail::VoxelCoord* c) {
+  return p.head<3>().allFinite() && detail::voxelCoord(p, inv_leaf, c);
 }
 
 bool before(const detail::VoxelCoord& a, const detail::VoxelCoord& b) {
@@ -29,8 +29,8 @@ bool before(const detail::VoxelCoord& a, const detail::VoxelCoord& b) {
 
 }  // namespace
 
-VoxelOrderedCloud::VoxelOrderedCloud(const std::vector<Eigen::Vector3d>& points, double leaf)
-    : cloud_size_(points.size()), leaf_(leaf) {
+VoxelOrderedCloud::VoxelOrderedCloud(const PointCloud& cloud, double leaf) : cloud_size_(cloud.size()), leaf_(leaf) {
+  const std::vector<Eigen::Vector4d>& points = cloud.points;
   checkLeaf(leaf, "VoxelOrderedCloud");
   if (points.size() >= std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("VoxelOrderedCloud: more than 2^32 - 1 points");
@@ -51,7 +51,7 @@ VoxelOrderedCloud::VoxelOrderedCloud(const std::vector<Eigen::Vector3d>& points,
   points_.reserve(keyed.size());
   place_.reserve(keyed.size());
   for (const Keyed& k : keyed) {
-    points_.push_back(points[k.i]);
+    points_.push_back(points[k.i].head<3>());
     place_.push_back(k.i);
   }
 }
@@ -73,7 +73,10 @@ PointCloud voxelDownsampleConcatenation(std::span<const VoxelOrderedCloud* const
     detail::VoxelCoord voxel;
   };
   std::vector<Cursor> heap;
-  const auto load = [&](Cursor& c) { voxelOf(clouds[c.cloud]->byVoxel()[c.next], inv_leaf, &c.voxel); };
+  const auto load = [&](Cursor& c) {
+    const Eigen::Vector3d& q = clouds[c.cloud]->byVoxel()[c.next];
+    voxelOf(Eigen::Vector4d(q.x(), q.y(), q.z(), 1.0), inv_leaf, &c.voxel);
+  };
   std::size_t largest = 0;
   for (std::size_t k = 0; k < clouds.size(); ++k) {
     largest = std::max(largest, clouds[k]->cloudSize());

@@ -18,8 +18,9 @@ namespace rigcal::registration {
 
 class VoxelOrderedCloud {
  public:
-  /// Throws std::invalid_argument unless leaf is finite and > 0, or with 2^32 points or more.
-  VoxelOrderedCloud(const std::vector<Eigen::Vector3d>& points, double leaf);
+  /// The cloud's positions (w ignored, as voxelDownsample does). Throws std::invalid_argument unless leaf is
+  /// finite and > 0, or with 2^32 points or more.
+  VoxelOrderedCloud(const PointCloud& cloud, double leaf);
 
   [[nodiscard]] double leaf() const { return leaf_; }
   /// The points a voxel holds (non-finite ones and those beyond any voxel left out), by voxel and, within
