@@ -223,6 +223,62 @@ TEST(LidarLidarVerdict, AFramesScatterAlongWhatItSeesBestCountsInFull) {
   EXPECT_NEAR(same.evidence.frame_uncertainty_m, 2.0 * std::sqrt(0.0017) / 4.0, 1e-9);
 }
 
+/// Another run on frame `f`, landing `offset` from the result at `score_share` above the frame's best score.
+void addTiedRun(LidarLidarResult& r, int f, const Eigen::Vector3d& offset, double score_share) {
+  RegistratorRun run;
+  run.frame = f;
+  run.registrator = "gicp";
+  run.frame_score = 0.001 * (1.0 + score_share);
+  Pose T = r.T_mapping_calib;
+  T.pretranslate(offset);
+  r.candidates.push_back(T);
+  run.result = r.candidates.size() - 1;
+  r.runs.push_back(run);
+}
+
+// yard-side's side_left (a VLP-32C rolled 90°, d60): one frame's best run slid 3.2 cm along the spin axis while
+// its icp_fine runs, at a score 0.5 % higher, lay 3.7 cm the other way; another frame's runs all lay within
+// 0.4 cm. Every frame's information is alike here, so only the frame's own runs can say that it does not know
+// where along z the result is: their spread at an equal score discounts it there, and the others decide (ok).
+TEST(LidarLidarVerdict, AFrameWhoseRunsTieAlongADirectionCountsLittleThere) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0, 1.0});
+  moveFrame(r, 2, {0, 0, 0.04});
+  for (int f = 0; f < 4; ++f) r.frame_information[f] = diagonalInformation(100, 100, 100);
+  judgeLidarLidar(r, 4, 10.0);
+  ASSERT_EQ(r.verdict, Verdict::kUnverified) << "a frame that knows where it is and disagrees by 4 cm";
+  EXPECT_NEAR(r.evidence.frame_uncertainty_m, 0.02, 1e-9);
+
+  addTiedRun(r, 2, {0, 0, -0.02}, 0.01);  // its own other answer, 6 cm away at a score 1 % higher
+  judgeLidarLidar(r, 4, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.doubt;
+  EXPECT_LT(r.evidence.frame_uncertainty_m, 0.001);
+  EXPECT_NEAR(r.evidence.frame_spread_m, 0.04, 1e-9);  // its best still says where it went
+}
+
+// A run clearly worse than the frame's best (10 %: the frame does tell them apart) does not discount it.
+TEST(LidarLidarVerdict, ARunTheFramesScoreTellsApartDoesNotDiscountIt) {
+  auto r = resultWithFrames({1.0, 1.0, 1.0, 1.0});
+  moveFrame(r, 2, {0, 0, 0.04});
+  for (int f = 0; f < 4; ++f) r.frame_information[f] = diagonalInformation(100, 100, 100);
+  addTiedRun(r, 2, {0, 0, -0.02}, 0.10);
+  judgeLidarLidar(r, 4, 10.0);
+  EXPECT_EQ(r.verdict, Verdict::kUnverified);
+  EXPECT_NEAR(r.evidence.frame_uncertainty_m, 0.02, 1e-9);
+}
+
+// Frames' scores weigh them too: the points' noise left in a frame is its score over its information, so of
+// two frames that see alike the one whose points fit four times worse counts a quarter as much.
+TEST(LidarLidarVerdict, AFrameWhosePointsFitWorseCountsLess) {
+  auto r = resultWithFrames({1.0, 1.0});
+  moveFrame(r, 1, {0, 0, 0.04});
+  for (int f = 0; f < 2; ++f) r.frame_information[f] = diagonalInformation(100, 100, 100);
+  for (auto& run : r.runs)
+    if (run.frame == 1) run.frame_score *= 4.0;
+  judgeLidarLidar(r, 2, 10.0);
+  // W = 1 and 1/4 (relative): 2 · sqrt((0.25 · 0.04)²) / 1.25.
+  EXPECT_NEAR(r.evidence.frame_uncertainty_m, 2.0 * 0.25 * 0.04 / 1.25, 1e-9);
+}
+
 // A frame without information (cut before the result was reached): every frame counts alike, as before.
 TEST(LidarLidarVerdict, WithoutEveryFramesInformationFramesCountAlike) {
   auto r = resultWithFrames({1.0, 1.0, 1.0, 1.0});

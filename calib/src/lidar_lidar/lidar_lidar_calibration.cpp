@@ -36,16 +36,18 @@ TrajectoryClockEstimate trajectoryClock(const pipeline::CalibrationDataset& data
   }
 }
 
-/// Each frame's information at the result over at most `max_points` source points in all (a common stride, so
-/// that frames keep their relative weights): ~20k nearest-neighbour queries, tens of milliseconds, not cut.
+/// Each frame's information at the result, estimated from at most `max_points` source points in all (every
+/// stride-th, times the stride: the verdict sets it against the frame's score as the points' noise): ~20k
+/// nearest-neighbour queries, tens of milliseconds, not cut.
 void frameInformation(const detail::Calibrator& calibrator, const config::Parameters& params, LidarLidarResult& out,
                       std::size_t max_points = 20000) {
   std::size_t total = 0;
   for (const auto& f : calibrator.frames()) total += f.source.size();
   const std::size_t stride = std::max<std::size_t>(1, (total + max_points - 1) / max_points);
   for (const auto& f : calibrator.frames())
-    out.frame_information[int(f.index)] = framePoseInformation(*f.target, f.source, out.T_mapping_calib,
-                                                               params.calibration_eval_max_corr_distance, stride);
+    out.frame_information[int(f.index)] =
+        double(stride) * framePoseInformation(*f.target, f.source, out.T_mapping_calib,
+                                              params.calibration_eval_max_corr_distance, stride);
 }
 
 /// Where the searches for another basin stop: `search_share` of the time left, less what a second clock

@@ -31,16 +31,60 @@ Vector6d deviation(const Pose& result, const Pose& frame) {
   return d;
 }
 
-/// Two standard errors (m, deg) of the result from its frames' deviations d_k and informations H_k. Refined
-/// over all frames, the result is to first order their information-weighted mean, A⁻¹ Σ H_k x_k with
-/// A = Σ H_k, so its covariance from their scatter is A⁻¹ (Σ H_k d_k d_kᵀ H_k) A⁻¹: a frame's deviation
-/// along a direction it hardly sees counts as little as it pulls the result there. With equal H_k it is
-/// Σ d_k d_kᵀ / n², the frames' plain standard error. Nullopt-like {-1, -1} when A is singular.
-Distance weightedUncertainty(const std::vector<Vector6d>& d, const std::vector<PoseInformation>& H) {
+/// What one agreeing frame says about the result, and how well.
+struct FrameEvidence {
+  Vector6d deviation = Vector6d::Zero();                  // the mean of its tied runs, deviation(result, ·)
+  PoseInformation information = PoseInformation::Zero();  // result.frame_information
+  double score = 0.0;                                     // its best frame score (m²)
+  PoseInformation ambiguity = PoseInformation::Zero();    // the spread of its tied runs about their mean
+};
+
+/// Frame evidence from its runs (those the verdict judges it by) whose scores are at most `tie` (m²): answers the
+/// frame cannot tell apart. Where its cost is flat they spread, and the best of them is chance: yard-side's rolled
+/// lidars had frames whose runs lay 1.7-6.8 cm apart along the spin axis at scores 0.5 % apart, and the best
+/// (or a frame's hundreds of runs in the exhaustive search) chose among them. So the frame says their mean, as
+/// far as their spread.
+FrameEvidence frameEvidence(const LidarLidarResult& r, const std::vector<const RegistratorRun*>& runs, double tie,
+                            const PoseInformation& information) {
+  std::vector<Vector6d> tied;
+  FrameEvidence f;
+  f.information = information;
+  f.score = tie;
+  for (const auto* run : runs) {
+    if (run->frame_score > tie) continue;
+    tied.push_back(deviation(r.T_mapping_calib, r.candidates[run->result]));
+    f.deviation += tied.back();
+    f.score = std::min(f.score, run->frame_score);
+  }
+  f.deviation /= double(tied.size());
+  for (const auto& d : tied) f.ambiguity += (d - f.deviation) * (d - f.deviation).transpose();
+  f.ambiguity /= double(tied.size());
+  return f;
+}
+
+/// The weight of a frame's deviation: the inverse of its covariance, which is what its points' noise leaves
+/// (score · H⁻¹; the score counts outliers at d_max², so an upper bound) plus what its own registrators leave
+/// open (`ambiguity`). Zero when the frame has no information.
+PoseInformation frameWeight(const FrameEvidence& f) {
+  const Eigen::SelfAdjointEigenSolver<PoseInformation> es(f.information);
+  const double largest = es.eigenvalues()(5);
+  if (!(largest > 0.0)) return PoseInformation::Zero();
+  const Vector6d noise = std::max(f.score, 1e-12) * es.eigenvalues().cwiseMax(1e-12 * largest).cwiseInverse();
+  const PoseInformation C = es.eigenvectors() * noise.asDiagonal() * es.eigenvectors().transpose() + f.ambiguity;
+  return C.ldlt().solve(PoseInformation::Identity());
+}
+
+/// Two standard errors (m, deg) of the result from its frames' deviations d_k and weights W_k. Refined
+/// over all frames, the result is to first order their weighted mean, A⁻¹ Σ W_k x_k with A = Σ W_k, so its
+/// covariance from their scatter is A⁻¹ (Σ W_k d_k d_kᵀ W_k) A⁻¹: a frame's deviation along a direction it
+/// hardly sees, or cannot tell apart, counts as little as it pulls the result there. With equal W_k it is
+/// Σ d_k d_kᵀ / n², the frames' plain standard error. {-1, -1} when A is singular.
+Distance weightedUncertainty(const std::vector<FrameEvidence>& frames) {
   PoseInformation A = PoseInformation::Zero(), B = PoseInformation::Zero();
-  for (std::size_t k = 0; k < d.size(); ++k) {
-    A += H[k];
-    const Vector6d w = H[k] * d[k];
+  for (const auto& f : frames) {
+    const PoseInformation W = frameWeight(f);
+    A += W;
+    const Vector6d w = W * f.deviation;
     B += w * w.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<PoseInformation> es(A);
@@ -88,21 +132,24 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
   for (const auto& run : r.runs)
     if (run.redeskewed && run.frame >= 0 && run.frame_score >= 0 && run.result < r.candidates.size())
       redeskewed_frames.insert(run.frame);
-  std::map<int, const RegistratorRun*> frame_best;
+  std::map<int, std::vector<const RegistratorRun*>> frame_runs;  // the runs each frame is judged by
   std::set<std::string> agreeing;
   for (const auto& run : r.runs) {
     if (run.result >= r.candidates.size()) continue;
     if (near(distance(r.candidates[run.result], r.T_mapping_calib))) agreeing.insert(run.registrator);
     if (run.frame < 0 || run.frame_score < 0) continue;
     if (redeskewed_frames.count(run.frame) != 0 && !run.redeskewed) continue;
-    auto& best = frame_best[run.frame];
-    if (best == nullptr || run.frame_score < best->frame_score) best = &run;
+    frame_runs[run.frame].push_back(&run);
   }
+  std::map<int, const RegistratorRun*> frame_best;
+  for (const auto& [frame, runs] : frame_runs)
+    frame_best[frame] = *std::min_element(runs.begin(), runs.end(), [](const auto* a, const auto* b) {
+      return a->frame_score < b->frame_score;
+    });
   e.registrators_agreeing.assign(agreeing.begin(), agreeing.end());
   e.frames_registered = frame_best.size();
   double sum_sq_m = 0.0, sum_sq_deg = 0.0;
-  std::vector<Vector6d> deviations;
-  std::vector<PoseInformation> informations;
+  std::vector<FrameEvidence> weighed;
   bool every_frame_weighted = true;
   for (const auto& [frame, run] : frame_best) {
     const Distance d = distance(r.candidates[run->result], r.T_mapping_calib);
@@ -117,15 +164,15 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
       every_frame_weighted = false;
       continue;
     }
-    deviations.push_back(deviation(r.T_mapping_calib, r.candidates[run->result]));
-    informations.push_back(info->second);
+    weighed.push_back(frameEvidence(r, frame_runs.at(frame), run->frame_score * (1.0 + opt.equal_score_share),
+                                    info->second));
   }
   if (const double n = double(e.frames_agreeing); n >= 2) {
     // rms / sqrt(n) = sqrt(sum / n²): the standard error of the frames' mean about the final result.
     e.frame_uncertainty_m = 2.0 * std::sqrt(sum_sq_m) / n;
     e.frame_uncertainty_deg = 2.0 * std::sqrt(sum_sq_deg) / n;
     if (every_frame_weighted) {
-      const Distance w = weightedUncertainty(deviations, informations);
+      const Distance w = weightedUncertainty(weighed);
       if (w.m >= 0) {
         e.frame_uncertainty_m = w.m;
         e.frame_uncertainty_deg = w.deg;

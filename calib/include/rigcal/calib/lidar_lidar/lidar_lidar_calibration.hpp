@@ -79,8 +79,9 @@ struct LidarLidarEvidence {
   // an outlier frame counts against the result as a disagreeing frame instead); 0 with fewer than two.
   double frame_uncertainty_m = 0.0;
   double frame_uncertainty_deg = 0.0;
-  // Each frame's deviation weighted by its information in each direction (result.frame_information; see
-  // lidar_lidar_verdict.cpp): false when some agreeing frame has none, then every frame counts alike.
+  // Each frame's deviation weighted in each direction by its information over its score and by how far its
+  // equally good runs spread (result.frame_information; see lidar_lidar_verdict.cpp): false when some agreeing
+  // frame has no information, then every frame counts alike.
   bool frame_uncertainty_weighted = false;
   std::vector<std::string> registrators_agreeing;  // registrators with a result near the final one
   double inlier_ratio = 0.0;         // of the final score
@@ -112,7 +113,8 @@ struct LidarLidarResult {
   std::string doubt;                   // one line when verdict is kUnverified: why, and what is missing
   LidarLidarEvidence evidence;
   // Per dataset frame registered: its information at the result, on the sources the result was refined on
-  // (frame_pose_information.hpp), which weights the frame's scatter in the verdict. Empty: weighted equally.
+  // (frame_pose_information.hpp, over the whole frame), which weights the frame's scatter in the verdict.
+  // Empty: weighted equally.
   std::map<int, PoseInformation> frame_information;
   TrajectoryClockEstimate trajectory_clock;  // kNotRun unless LidarLidarOptions::trajectory_clock
 };

@@ -22,6 +22,9 @@ struct VerdictOptions {
   // cannot be called ok (a rear lidar came out 0.09° off, called ok, its frames scattering 0.10-0.14°).
   double goal_m = 0.01;
   double goal_deg = 0.05;
+  // A frame's runs whose scores lie within this share of its best are answers it cannot tell apart: their
+  // spread about its best discounts the frame where they differ (lidar_lidar_verdict.cpp).
+  double equal_score_share = 0.02;
 };
 
 /// Fills result.evidence, result.verdict and result.doubt. `frames_selected` is the dataset's frame
