@@ -33,7 +33,7 @@ NdtGrid::NdtGrid(const PointCloud& cloud, const NdtGridOptions& options) : optio
   std::vector<Accumulator> acc;
   for (const auto& p : cloud.points) {
     detail::VoxelCoord c;
-    if (!p.head<3>().allFinite() || !detail::voxelCoord(p, inv_resolution_, &c)) continue;
+    if (!detail::voxelCoord(p, inv_resolution_, &c)) continue;
     const std::uint32_t v = map.findOrInsert(c);
     if (v == acc.size()) {
       acc.emplace_back();

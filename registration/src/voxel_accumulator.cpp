@@ -104,7 +104,7 @@ void VoxelAccumulator::add(std::span<const Eigen::Vector4d> points) {
   added_ += points.size();
   for (const auto& p : points) {
     detail::VoxelCoord c;
-    if (!p.head<3>().allFinite() || !detail::voxelCoord(p, s.inv_leaf, &c)) {
+    if (!detail::voxelCoord(p, s.inv_leaf, &c)) {
       ++dropped_;
       continue;
     }

@@ -21,7 +21,7 @@ PointCloud voxelDownsample(const PointCloud& cloud, double leaf_size, VoxelGridS
   std::size_t dropped = 0;
   for (const auto& p : cloud.points) {
     detail::VoxelCoord c;
-    if (!p.head<3>().allFinite() || !detail::voxelCoord(p, inv_leaf, &c)) {
+    if (!detail::voxelCoord(p, inv_leaf, &c)) {
       ++dropped;
       continue;
     }

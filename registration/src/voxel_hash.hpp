@@ -17,7 +17,9 @@ struct VoxelCoord {
   friend bool operator==(const VoxelCoord&, const VoxelCoord&) = default;
 };
 
-/// floor(p / leaf) per axis; false for a non-finite point or one beyond ±2^62 voxels from the origin.
+/// floor(p / leaf) per axis; false for a non-finite point or one beyond ±2^62 voxels from the origin. The one
+/// rule of which points a voxel holds, for every voxel pass (voxelDownsample, VoxelAccumulator, the NDT grid,
+/// VoxelOrderedCloud, whose merge is voxelDownsample's bit for bit only as long as they drop the same points).
 inline bool voxelCoord(const Eigen::Vector4d& p, double inv_leaf, VoxelCoord* out) {
   constexpr double kLimit = 4.6e18;  // < 2^62, leaves room for ±1 neighbour offsets
   const double fx = std::floor(p.x() * inv_leaf);

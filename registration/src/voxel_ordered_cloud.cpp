@@ -18,11 +18,8 @@ void checkLeaf(double leaf, const char* who) {
     throw std::invalid_argument(std::string(who) + ": leaf must be finite and > 0, got " + std::to_string(leaf));
 }
 
-/// voxelDownsample's voxel of p (false where it drops p).
-bool voxelOf(const Eigen::Vector4d& p, double inv_leaf, detail::VoxelCoord* c) {
-  return p.head<3>().allFinite() && detail::voxelCoord(p, inv_leaf, c);
-}
-
+/// The merge's order of voxels (any total order would do: voxelDownsample's first-hit order is restored from
+/// the points' places in their clouds).
 bool before(const detail::VoxelCoord& a, const detail::VoxelCoord& b) {
   return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
 }
@@ -43,7 +40,7 @@ VoxelOrderedCloud::VoxelOrderedCloud(const PointCloud& cloud, double leaf) : clo
   keyed.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     detail::VoxelCoord c;
-    if (voxelOf(points[i], inv_leaf, &c)) keyed.push_back({c, std::uint32_t(i)});
+    if (detail::voxelCoord(points[i], inv_leaf, &c)) keyed.push_back({c, std::uint32_t(i)});
   }
   std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
     return before(a.c, b.c) || (a.c == b.c && a.i < b.i);
@@ -75,7 +72,7 @@ PointCloud voxelDownsampleConcatenation(std::span<const VoxelOrderedCloud* const
   std::vector<Cursor> heap;
   const auto load = [&](Cursor& c) {
     const Eigen::Vector3d& q = clouds[c.cloud]->byVoxel()[c.next];
-    voxelOf(Eigen::Vector4d(q.x(), q.y(), q.z(), 1.0), inv_leaf, &c.voxel);
+    detail::voxelCoord(Eigen::Vector4d(q.x(), q.y(), q.z(), 1.0), inv_leaf, &c.voxel);  // kept: it has one
   };
   std::size_t largest = 0;
   for (std::size_t k = 0; k < clouds.size(); ++k) {
