@@ -7,6 +7,7 @@
 
 #include "rigcal/calib/lidar_lidar/calibration_budget.hpp"
 #include "rigcal/calib/lidar_lidar/ensemble_plan.hpp"
+#include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 
 namespace rigcal::calib::detail {
 
@@ -164,6 +165,9 @@ bool Calibrator::restOfPlan(std::size_t first_frames) {
   for (std::size_t k = 1; k < frames_.size() && !stopped(); ++k) frameEnsemble(k, false);
   if (!samePose(before_ensembles, best_) && !stopped()) batchedChain(best_);
   seconds_.ensemble += since(t);
+  t = Clock::now();
+  if (!stopped() && setAsideDisagreeingFrames()) batchedChain(best_);
+  seconds_.batched += since(t);
   // Complete only if the registrations' own deadline has not passed either: the last ones ran into it
   // otherwise (a 1 s plan ended with two ensembles "timeout" 1 ms in, before the real deadline).
   return !registrationDeadline().expired();
@@ -202,14 +206,46 @@ void Calibrator::rescore() {
 
 void Calibrator::rebuildScorePairs() {
   std::vector<SourceTarget> full;
-  for (auto& f : frames_) full.push_back({&f.source, f.target.get()});
+  for (auto& f : frames_)
+    if (!f.set_aside) full.push_back({&f.source, f.target.get()});
   const std::size_t stride = scoreStride(full, opt_.score_points);
   score_pairs_.clear();
   for (auto& f : frames_) {
+    if (f.set_aside) continue;
     f.score_source.points.clear();
     for (std::size_t i = 0; i < f.source.size(); i += stride) f.score_source.points.push_back(f.source.points[i]);
     score_pairs_.push_back({&f.score_source, f.target.get()});
   }
+}
+
+bool Calibrator::setAsideDisagreeingFrames() {
+  if (!redeskewed_) return false;
+  const VerdictOptions agree;
+  std::size_t aside = 0;
+  for (auto& f : frames_) {
+    const RegistratorRun* own = nullptr;  // the frame's best run on its re-deskewed source
+    for (const auto& run : out_.runs)
+      if (run.frame == int(f.index) && run.redeskewed && run.frame_score >= 0 && run.result < out_.candidates.size() &&
+          (own == nullptr || run.frame_score < own->frame_score))
+        own = &run;
+    const Pose* T = own != nullptr ? &out_.candidates[own->result] : nullptr;
+    f.set_aside = T != nullptr && ((T->translation() - best_.translation()).norm() > agree.agree_m ||
+                                   rad2deg(rotationAngleBetween(*T, best_)) > agree.agree_deg);
+    if (f.set_aside) ++aside;
+  }
+  const std::size_t agreeing = frames_.size() - aside;
+  // Two scores over the frames kept (the guess's and the best's), which the comparisons from here on need.
+  if (aside == 0 || agreeing < 2 || aside >= agreeing || !fits(deadline_, 2.0 * score_seconds_)) {
+    for (auto& f : frames_) f.set_aside = false;
+    return false;
+  }
+  rebuildScorePairs();
+  initial_score_ = score(data_.T_mapping_calib_guess);
+  out_.initial_score = initial_score_;
+  best_score_ = score(best_);
+  for (const auto& f : frames_)
+    if (f.set_aside) out_.frames_set_aside.push_back(f.index);
+  return true;
 }
 
 CalibrationScore Calibrator::score(const Pose& T) {

@@ -37,6 +37,7 @@ struct Frame {
   PointCloud source;        // covariances only once a GICP ran on the frame (ensureSourceCovariances)
   PointCloud score_source;  // every stride-th point: what the all-frames score looks at
   std::shared_ptr<const Target> target;
+  bool set_aside = false;  // out of the objective (setAsideDisagreeingFrames)
 };
 
 /// What building a frame came to: the frame, a frame skipped for want of points, or no time to build it.
@@ -129,10 +130,16 @@ class Calibrator {
   /// lidar, so that the verdict can check that the frames agree before the deadline cuts the full ensembles.
   void confirmOnFrame(std::size_t k);
 
+  /// Frames whose own registration on their re-deskewed source lands away from the best (beyond the verdict's
+  /// agreement distance) leave the all-frames score and the batched ICP, when a majority of at least two
+  /// agrees: a frame that sees a target the others contradict (a slid or mis-posed augmented cloud) pulls the
+  /// result by its share otherwise. True when some were set aside (the scores and the best were redone).
+  bool setAsideDisagreeingFrames();
+
   /// What batchedChain over `frames` frames is expected to take, from the ICP fine runs so far (0 before any).
   [[nodiscard]] double batchedChainEstimate(std::size_t frames) const;
 
-  /// Batched ICP over all frames at 0.5 → 0.1 → 0.05 m from `start`.
+  /// Batched ICP over all frames (but those set aside) at 0.5 → 0.1 → 0.05 m from `start`.
   void batchedChain(const Pose& start);
 
   /// Re-deskews every frame with the best extrinsic, then the batched ICP chain from the best, then each

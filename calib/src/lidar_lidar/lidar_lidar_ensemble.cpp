@@ -109,7 +109,8 @@ void Calibrator::confirmOnFrame(std::size_t k) {
 
 void Calibrator::batchedChain(const Pose& start) {
   std::vector<SourceTarget> pairs;
-  for (auto& f : frames_) pairs.push_back({&f.source, f.target.get()});
+  for (auto& f : frames_)
+    if (!f.set_aside) pairs.push_back({&f.source, f.target.get()});
   Pose T = start;
   for (const double d : batchedDistances(params_)) {
     if (stopped()) return;

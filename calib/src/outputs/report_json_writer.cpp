@@ -116,6 +116,7 @@ json lidarJson(const pipeline::CalibrationDataset& d, const LidarLidarResult* r)
   for (const auto& [name, s] : r->stage_seconds) stages[name] = s;
   j["stage_seconds"] = stages;
   j["frames_skipped"] = r->frames_skipped;
+  j["frames_set_aside"] = r->frames_set_aside;
   json runs = json::array();
   std::map<std::string, json> totals;
   for (const auto& run : r->runs) {

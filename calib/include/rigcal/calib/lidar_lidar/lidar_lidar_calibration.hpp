@@ -105,6 +105,9 @@ struct LidarLidarResult {
   CalibrationScore final_score;
   std::vector<std::size_t> frames_used;       // dataset frame indices that had a target
   std::vector<std::string> frames_skipped;    // "frame 3: <why>"
+  // Dataset frames registered but left out of the final score and batched ICP: their own re-deskewed
+  // registration disagreed with the result while a majority agreed (the verdict counts them as disagreeing).
+  std::vector<std::size_t> frames_set_aside;
   std::vector<Pose> candidates;               // [0] = the initial guess
   std::vector<RegistratorRun> runs;
   std::vector<std::pair<std::string, double>> stage_seconds;  // targets, ensemble, batched, redeskew+final
