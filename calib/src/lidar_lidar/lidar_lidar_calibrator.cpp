@@ -220,7 +220,6 @@ void Calibrator::rebuildScorePairs() {
 
 bool Calibrator::setAsideDisagreeingFrames() {
   if (!redeskewed_) return false;
-  const VerdictOptions agree;
   std::size_t aside = 0;
   for (auto& f : frames_) {
     const RegistratorRun* own = nullptr;  // the frame's best run on its re-deskewed source
@@ -228,9 +227,7 @@ bool Calibrator::setAsideDisagreeingFrames() {
       if (run.frame == int(f.index) && run.redeskewed && run.frame_score >= 0 && run.result < out_.candidates.size() &&
           (own == nullptr || run.frame_score < own->frame_score))
         own = &run;
-    const Pose* T = own != nullptr ? &out_.candidates[own->result] : nullptr;
-    f.set_aside = T != nullptr && ((T->translation() - best_.translation()).norm() > agree.agree_m ||
-                                   rad2deg(rotationAngleBetween(*T, best_)) > agree.agree_deg);
+    f.set_aside = own != nullptr && !agrees(out_.candidates[own->result], best_);
     if (f.set_aside) ++aside;
   }
   const std::size_t agreeing = frames_.size() - aside;

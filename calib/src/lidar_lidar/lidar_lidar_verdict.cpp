@@ -20,6 +20,8 @@ Distance distance(const Pose& a, const Pose& b) {
   return {(a.translation() - b.translation()).norm(), rad2deg(rotationAngleBetween(a, b))};
 }
 
+bool near(const Distance& d, const VerdictOptions& opt) { return d.m <= opt.agree_m && d.deg <= opt.agree_deg; }
+
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 /// `frame` as a small change of `result`: frame = result · exp([δt, δr]) (the calibration lidar's own frame).
@@ -105,6 +107,10 @@ double suggestDeadline(double deadline_s, std::size_t frames_selected, std::size
 
 }  // namespace
 
+bool agrees(const Pose& T, const Pose& result, const VerdictOptions& options) {
+  return near(distance(T, result), options);
+}
+
 const char* toString(Verdict v) {
   switch (v) {
     case Verdict::kOk: return "ok";
@@ -124,7 +130,6 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
     r.verdict = Verdict::kFailed;
     return;
   }
-  const auto near = [&](const Distance& d) { return d.m <= opt.agree_m && d.deg <= opt.agree_deg; };
   // Each frame's own best registration (lowest score on that frame): where that frame alone puts the lidar.
   // Once a frame was registered on its source re-deskewed with the best extrinsic, only those runs count:
   // the earlier ones saw the scan bent by the guess's deskew, and their scores are of another cloud.
@@ -136,7 +141,7 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
   std::set<std::string> agreeing;
   for (const auto& run : r.runs) {
     if (run.result >= r.candidates.size()) continue;
-    if (near(distance(r.candidates[run.result], r.T_mapping_calib))) agreeing.insert(run.registrator);
+    if (agrees(r.candidates[run.result], r.T_mapping_calib, opt)) agreeing.insert(run.registrator);
     if (run.frame < 0 || run.frame_score < 0) continue;
     if (redeskewed_frames.count(run.frame) != 0 && !run.redeskewed) continue;
     frame_runs[run.frame].push_back(&run);
@@ -155,7 +160,7 @@ void judgeLidarLidar(LidarLidarResult& r, std::size_t frames_selected, double de
     const Distance d = distance(r.candidates[run->result], r.T_mapping_calib);
     e.frame_spread_m = std::max(e.frame_spread_m, d.m);
     e.frame_spread_deg = std::max(e.frame_spread_deg, d.deg);
-    if (!near(d)) continue;  // an outlier frame is judged by the majority rule below, not as scatter
+    if (!near(d, opt)) continue;  // an outlier frame is judged by the majority rule below, not as scatter
     ++e.frames_agreeing;
     sum_sq_m += d.m * d.m;
     sum_sq_deg += d.deg * d.deg;

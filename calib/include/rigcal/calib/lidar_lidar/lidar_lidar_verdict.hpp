@@ -27,6 +27,10 @@ struct VerdictOptions {
   double equal_score_share = 0.02;
 };
 
+/// Whether a registration's result `T` confirms `result`: within agree_m and agree_deg of it. What the verdict
+/// counts as an agreeing frame or registrator, and what the calibration keeps a frame in its objective by.
+bool agrees(const Pose& T, const Pose& result, const VerdictOptions& options = {});
+
 /// Fills result.evidence, result.verdict and result.doubt. `frames_selected` is the dataset's frame
 /// count, `deadline_s` the calibration_deadline_s the run had (for the suggested --deadline).
 void judgeLidarLidar(LidarLidarResult& result, std::size_t frames_selected, double deadline_s,
