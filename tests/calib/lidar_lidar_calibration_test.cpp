@@ -1,16 +1,14 @@
 // Lidar-lidar calibration on simulator data (tests/calib/lidar_lidar_sim_dataset.*): accuracy from a
-// 0.3 m / 5° guess, determinism, the deadline, several lidars sharing it, and bad input.
+// 0.3 m / 5° guess, determinism, the deadline, several lidars sharing it, a frame that contradicts the others,
+// and bad input. What the calibration hands on (base lidar, output files): lidar_lidar_sim_outputs_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
-#include <filesystem>
 #include <cmath>
 #include <memory>
 
-#include "lidar_lidar_sim_dataset.hpp"
-#include "rigcal/calib/base_lidar/base_lidar_calibration.hpp"
+#include "lidar_lidar_sim_suite.hpp"
 #include "rigcal/calib/lidar_lidar/augmented_target.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_deskew.hpp"
 #include "rigcal/calib/lidar_lidar/calibration_source.hpp"
@@ -19,14 +17,6 @@
 #include "rigcal/calib/lidar_lidar/calibration_score.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_verdict.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_worker.hpp"
-#include "rigcal/calib/outputs/calibration_yaml_writer.hpp"
-#include "rigcal/calib/outputs/cloud_writers.hpp"
-#include "rigcal/calib/outputs/overview_png_writer.hpp"
-#include "rigcal/calib/outputs/report_json_writer.hpp"
-#include "rigcal/calib/outputs/summary_table.hpp"
-#include "rigcal/core/pcd_io.hpp"
-#include "rigcal/registration/evaluator.hpp"
-#include "test_data.hpp"
 #include "rigcal/calib/lidar_lidar/lidar_lidar_calibration.hpp"
 #include "sanitizers.hpp"
 
@@ -34,29 +24,6 @@ namespace rigcal::calib {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-/// The calibration lidars one after the other, sharing params.calibration_deadline_s from now through a
-/// CalibrationBudget (what the lidar-lidar worker does as the datasets arrive).
-std::vector<LidarLidarResult> calibrateInTurn(const std::vector<pipeline::CalibrationDataset>& datasets,
-                                              const config::Parameters& params) {
-  CalibrationBudget budget(Clock::now(), params.calibration_deadline_s, datasets.size());
-  std::vector<LidarLidarResult> results;
-  for (const auto& d : datasets) {
-    const auto share = budget.next();
-    results.push_back(calibrateLidarLidar(d, params, share, optionsForShare({}, budget)));
-  }
-  return results;
-}
-
-class LidarLidarSim : public ::testing::Test {
- protected:
-  static const test::SimDatasets& data() { return test::flatParkingLot(); }
-  static void TearDownTestSuite() { test::releaseFlatParkingLot(); }
-
-  static double translationError(const Pose& a, const Pose& b) { return (a.translation() - b.translation()).norm(); }
-  static double rotationErrorDeg(const Pose& a, const Pose& b) { return rad2deg(rotationAngleBetween(a, b)); }
-
-};
 
 TEST_F(LidarLidarSim, EachCalibrationLidarWithinOneCentimetreAndFiveHundredthsOfADegree) {
   config::Parameters params = data().params;
@@ -368,63 +335,6 @@ TEST_F(LidarLidarSim, RedeskewWithTheTrueExtrinsicMatchesTheTruth) {
   EXPECT_GT(max_diff, 1e-3);   // the guess's lever arm bends the sweep differently
   EXPECT_LT(first_diff, 1e-3); // both are exact at the reference time
   EXPECT_THROW(mappingPoseAt({}, 0), std::invalid_argument);
-}
-
-TEST_F(LidarLidarSim, BaseLidarZRollPitchFromTheSimulatedGround) {
-  if (RIGCAL_SANITIZED) GTEST_SKIP() << "simulation-heavy: Release only (the accuracy test exercises the same code instrumented)";
-  config::Parameters params = data().params;
-  params.base_lidar_max_inlier_distance = 0.03;  // 2 cm range noise and 4 cm bumps
-  // The ground near the car: the lot's 1.2 % slope and bumps bend the plane further out.
-  params.base_lidar_crop_box_min_x = params.base_lidar_crop_box_min_y = -8.0;
-  params.base_lidar_crop_box_max_x = params.base_lidar_crop_box_max_y = 8.0;
-  const Pose truth = data().truth_T_base_mapping;
-  const Pose guess = test::perturb(truth, 0.3, 5.0, 99);
-  const auto r = calibrateBaseLidar(data().ground_cloud_mapping, guess, params);
-  ASSERT_TRUE(r.ok) << r.failure;
-  const XyzRpy got = toXyzRpy(r.T_base_lidar), want = toXyzRpy(truth);
-  std::printf("base-lidar: z %.4f (truth %.4f), roll %.4f deg (%.4f), pitch %.4f deg (%.4f)\n", got.z, want.z,
-              rad2deg(got.roll), rad2deg(want.roll), rad2deg(got.pitch), rad2deg(want.pitch));
-  EXPECT_NEAR(got.z, want.z, 0.01);
-  EXPECT_NEAR(rad2deg(got.roll), rad2deg(want.roll), 0.05);
-  EXPECT_NEAR(rad2deg(got.pitch), rad2deg(want.pitch), 0.05);
-}
-
-TEST_F(LidarLidarSim, OutputsOfARealRunPutTheAfterCloudOnTheMap) {
-  if (RIGCAL_SANITIZED) GTEST_SKIP() << "wall-clock budget measured in the optimised build only";
-  config::Parameters params = data().params;
-  params.calibration_deadline_s = 4.0;
-  CalibrationOutcome o;
-  o.rig_name = "sim-parking-lot";
-  o.mapping_sensor = data().datasets.front().mapping_sensor;
-  o.version = "test";
-  o.deadline_s = params.calibration_deadline_s;
-  o.initial_T_base_sensor[o.mapping_sensor] = data().truth_T_base_mapping;
-  for (const auto& d : data().datasets)
-    o.initial_T_base_sensor[d.calibration_sensor] = data().truth_T_base_mapping * d.T_mapping_calib_guess;
-  o.datasets = data().datasets;
-  o.lidars = calibrateInTurn(o.datasets, params);
-  test::TempDir dir;
-  // RIGCAL_KEEP_OUTPUTS=<dir>: write there instead, to look at them.
-  const char* keep = std::getenv("RIGCAL_KEEP_OUTPUTS");
-  const std::filesystem::path out = keep != nullptr ? std::filesystem::path(keep) : dir.path();
-  std::filesystem::create_directories(out);
-  writeCalibrationYaml(out / "calibration.yaml", o);
-  writeReportJson(out / "report.json", o);
-  writeCalibrationClouds(out, o);
-  writeOverviewPng(out / "overview.png", o);
-  std::printf("%s", summaryTable(o).c_str());
-  // The after clouds sit on the map far better than the before clouds.
-  const auto map = readPcd(out / "map.pcd");
-  const registration::Target target(registration::fromTable(map));
-  for (const auto& d : o.datasets) {
-    const auto before = registration::evaluate(target, registration::fromTable(readPcd(out / (d.calibration_sensor + "_before.pcd"))),
-                                               Pose::Identity(), 0.1);
-    const auto after = registration::evaluate(target, registration::fromTable(readPcd(out / (d.calibration_sensor + "_after.pcd"))),
-                                              Pose::Identity(), 0.1);
-    std::printf("%s on the map: inliers %.3f -> %.3f\n", d.calibration_sensor.c_str(), before.inlier_ratio, after.inlier_ratio);
-    EXPECT_GT(after.inlier_ratio, before.inlier_ratio + 0.2) << d.calibration_sensor;
-  }
-  EXPECT_GT(std::filesystem::file_size(out / "overview.png"), 10000u);
 }
 
 }  // namespace
