@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "rigcal/core/pcd_io.hpp"
 #include "run_command.hpp"
@@ -21,6 +24,24 @@ TEST(Cli, VersionHelpAndUsageErrors) {
   EXPECT_EQ(runRigcal({}).exit_code, 2);
   EXPECT_EQ(runRigcal({"no-such-command"}).exit_code, 2);
   EXPECT_EQ(runRigcal({"decode", "--help"}).exit_code, 0);
+}
+
+// `rigcal sim --list`: one preset a line, its name apart from its description whatever the name's length
+// (calibration-bay-degenerate had run into its text), and `sim --help` points there.
+TEST(Cli, SimListsEveryPresetApartFromItsDescription) {
+  const auto list = runRigcal({"sim", "--list"});
+  ASSERT_EQ(list.exit_code, 0) << list.err;
+  std::istringstream lines(list.out);
+  std::vector<std::string> names;
+  for (std::string line; std::getline(lines, line);) {
+    const auto end = line.find(' ');
+    ASSERT_NE(end, std::string::npos) << line;
+    EXPECT_EQ(line.compare(end, 2, "  "), 0) << "name and description run together: " << line;
+    names.push_back(line.substr(0, end));
+  }
+  for (const char* preset : {"parking-lot", "street", "yard-corners", "yard-side", "calibration-bay-degenerate"})
+    EXPECT_NE(std::find(names.begin(), names.end(), preset), names.end()) << preset;
+  EXPECT_NE(runRigcal({"sim", "--help"}).out.find("--list"), std::string::npos);
 }
 
 TEST(Cli, CheckConfigReportsConfigErrorsWithExitCode3) {

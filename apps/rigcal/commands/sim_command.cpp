@@ -4,6 +4,7 @@
 // writes the recording as MCAP bags instead (or too): recording.mcap (packets) and recording_points.mcap
 // (PointCloud2), each with /tf_static and /odom (see sim/bag_recording.hpp); --dump-scans adds the
 // simulated sweeps as PCD files per sensor.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -60,10 +61,11 @@ class ScanDumper : public sim::SimulationSink {
 
 void run(const SimArgs& a) {
   if (a.list) {
-    for (const auto& n : sim::builtinScenarioNames()) {
-      const sim::Scenario sc = sim::loadScenario(n);
-      std::cout << std::left << std::setw(14) << n << sc.description << '\n';
-    }
+    const auto names = sim::builtinScenarioNames();
+    std::size_t width = 0;
+    for (const auto& n : names) width = std::max(width, n.size());
+    for (const auto& n : names)
+      std::cout << std::left << std::setw(int(width + 2)) << n << sim::loadScenario(n).description << '\n';
     return;
   }
   if (a.out.empty()) throw CommandFailed(kExitUsage, "sim: --out DIR is required");
@@ -165,7 +167,7 @@ void run(const SimArgs& a) {
 void addSimCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("sim", "Simulate a rig recording with ground truth (truth.yaml, poses.csv, rig.yaml)");
   auto a = std::make_shared<SimArgs>();
-  cmd->add_option("--scenario", a->scenario, "Preset name (parking-lot, street, lost, pose, base-motion) or a scenario YAML file")
+  cmd->add_option("--scenario", a->scenario, "Preset name (`rigcal sim --list` lists them) or a scenario YAML file")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "Output folder (created if missing)");
   cmd->add_option("--seed", a->seed, "Seed (default: the scenario's)");
