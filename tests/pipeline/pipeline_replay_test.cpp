@@ -287,10 +287,17 @@ TEST(PipelineEndToEnd, ParkingLotOverLoopbackUdpAt1xDropsNoScan) {
   for (const auto& l : p.lidars) EXPECT_GE(l.scans, expected) << l.sensor;
   // Keeping up with 1x real time is speed: asserted in the optimised build only (under ASan the pairing
   // stage's per-candidate frame information fell behind and a realtime queue dropped 6 scans).
+  // Every scan that reached the mapper registers, but the first partial sweeps, which may be too small. In the
+  // optimised build that is every scan of the drive; under ASan beside a busy machine the realtime queue before
+  // deskew dropped 8 and the mapper got 24 (all registered): how many arrive is speed, not behaviour.
+  std::uint64_t reached_mapper = expected;
   if (rigcal::test::kWallClockAsserted) {
     for (const auto& q : st.queues) EXPECT_EQ(q.dropped, 0u) << q.name;
+  } else {
+    for (const auto& s : st.stages)
+      if (s.name == "mapper") reached_mapper = std::min<std::uint64_t>(expected, s.processed);
   }
-  EXPECT_GE(p.registered, expected - 2);  // the first partial sweeps may be too small to register
+  EXPECT_GE(p.registered + 2, reached_mapper);
 }
 
 }  // namespace
