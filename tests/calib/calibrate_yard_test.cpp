@@ -107,6 +107,11 @@ Calibrated calibrate(const std::string& preset, const std::vector<std::string>& 
   return c;
 }
 
+/// The test-name suffix of a preset parameter: Corners or Side.
+std::string presetTestName(const ::testing::TestParamInfo<const char*>& p) {
+  return std::string(p.param) == "yard-corners" ? "Corners" : "Side";
+}
+
 class CalibrateYard : public ::testing::TestWithParam<const char*> {};
 
 // The default deadline shared by every calibration lidar, as a user runs `rigcal calibrate`: every calibration
@@ -142,9 +147,7 @@ TEST_P(CalibrateYard, UnderTheDefaultDeadlineEveryLidarWithinTheGoal) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Yard, CalibrateYard, ::testing::Values("yard-corners", "yard-side"),
-                         [](const ::testing::TestParamInfo<const char*>& p) {
-                           return std::string(p.param) == "yard-corners" ? "Corners" : "Side";
-                         });
+                         presetTestName);
 
 class CalibrateYardLong : public ::testing::TestWithParam<const char*> {};
 
@@ -165,9 +168,7 @@ TEST_P(CalibrateYardLong, WithALongDeadlineEveryLidarWithinTheGoal) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Yard, CalibrateYardLong, ::testing::Values("yard-corners", "yard-side"),
-                         [](const ::testing::TestParamInfo<const char*>& p) {
-                           return std::string(p.param) == "yard-corners" ? "Corners" : "Side";
-                         });
+                         presetTestName);
 
 }  // namespace
 }  // namespace rigcal::test
