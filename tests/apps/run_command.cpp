@@ -16,15 +16,6 @@ extern char** environ;
 
 namespace rigcal::test {
 
-namespace {
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-}  // namespace
-
 RigcalProcess::RigcalProcess(const std::vector<std::string>& args, const std::vector<std::string>& launcher)
     : dir_(std::make_unique<TempDir>()) {
   std::vector<std::string> argv_storage = launcher;
@@ -60,8 +51,8 @@ CommandResult RigcalProcess::wait() {
   reaped_ = true;
   CommandResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  result.out = slurp(*dir_ / "out");
-  result.err = slurp(*dir_ / "err");
+  result.out = fileContents(*dir_ / "out");
+  result.err = fileContents(*dir_ / "err");
   return result;
 }
 

@@ -45,11 +45,6 @@ fs::path writeRig(const TempDir& dir, const std::string& second_name = "left", c
   return path;
 }
 
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
-
 std::vector<std::string> temporaries(const fs::path& dir) {
   std::vector<std::string> found;
   for (const auto& e : fs::recursive_directory_iterator(dir))
@@ -93,10 +88,10 @@ TEST(TrustOutputs, APlantedSymlinkIsReplacedNotFollowed) {
   fs::create_symlink(victim, dir / "out" / "recording.pcap");
   const auto r = runRigcal({"sim", "--scenario", "parking-lot", "--duration", "0.3", "--out", (dir / "out").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(readAll(victim), "precious");
+  EXPECT_EQ(fileContents(victim), "precious");
   EXPECT_FALSE(fs::is_symlink(dir / "out" / "rig.yaml"));
   EXPECT_FALSE(fs::is_symlink(dir / "out" / "recording.pcap"));
-  EXPECT_NE(readAll(dir / "out" / "rig.yaml").find("sensors:"), std::string::npos);
+  EXPECT_NE(fileContents(dir / "out" / "rig.yaml").find("sensors:"), std::string::npos);
   EXPECT_TRUE(temporaries(dir.path()).empty());
 }
 
@@ -109,7 +104,7 @@ TEST(TrustOutputs, AFailedWriteLeavesNoHalfFile) {
                           "' >'" + (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
   const int status = std::system(("bash -c \"" + cmd + "\"").c_str());
   ASSERT_TRUE(WIFEXITED(status));
-  const std::string err = readAll(dir / "stderr");
+  const std::string err = fileContents(dir / "stderr");
   EXPECT_EQ(WEXITSTATUS(status), 1) << err;
   EXPECT_NE(err.find("recording.pcap: write failed"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(dir / "out" / "recording.pcap")) << "a half capture under the final name";
@@ -150,7 +145,7 @@ TEST(TrustOutputs, AnUnwritableOutFolderFailsBeforeTheRun) {
 
 // The default rig with `from` replaced by `to` (each must occur).
 fs::path rigWith(const TempDir& dir, const std::string& from, const std::string& to) {
-  std::string text = readAll(writeRig(dir));
+  std::string text = fileContents(writeRig(dir));
   const auto at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from;
   if (at != std::string::npos) text.replace(at, from.size(), to);

@@ -42,7 +42,7 @@ TEST_F(BagPipeline, MapFromPacketBagEqualsMapFromPcapAndPointCloud2BagFollowsThe
 
   // PointCloud2: the rig names each sensor's topic (source: {topic: ...}); the clouds are the pcap's
   // sweeps, so the mapper sees the same points at the same times.
-  std::ofstream(g->dir / "rig_clouds.yaml") << rigWithTopics(readText(g->dir / "rig.yaml"), "points");
+  std::ofstream(g->dir / "rig_clouds.yaml") << rigWithTopics(fileContents(g->dir / "rig.yaml"), "points");
   const auto from_clouds = runRigcal({"map", "--config", (g->dir / "rig_clouds.yaml").string(), "--bag",
                                       g->clouds_bag.string(), "--out", (out / "clouds").string()});
   ASSERT_EQ(from_clouds.exit_code, 0) << from_clouds.err;
@@ -99,7 +99,7 @@ TEST_F(BagPipeline, InitialExtrinsicsFromTheBagsTfStaticAreComposedToBaseLink) {
   }
   // Decoded clouds need no packet model: `model: PointCloud2` (no calibration or metadata file).
   std::ofstream(g->dir / "rig_from_bag.yaml") << std::regex_replace(
-      rigWithTopics(readText(g->dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
+      rigWithTopics(fileContents(g->dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
       std::regex("model: \\S+"), "model: PointCloud2");
   const auto checked = runRigcal({"check-config", (g->dir / "rig_from_bag.yaml").string()});
   EXPECT_EQ(checked.exit_code, 0) << checked.err;
@@ -115,7 +115,7 @@ TEST_F(BagPipeline, InitialExtrinsicsFromTheBagsTfStaticAreComposedToBaseLink) {
                         "front_left"),
             std::string::npos)
       << ok.err;
-  std::string rig = readText(g->dir / "rig_from_bag.yaml");
+  std::string rig = fileContents(g->dir / "rig_from_bag.yaml");
   rig = std::regex_replace(rig, std::regex("topic: /sensing/lidar/front_right/points\\}"),
                            "topic: /sensing/lidar/front_right/points, frame: front_right_optical}");
   std::ofstream(g->dir / "rig_bad_frame.yaml") << rig;

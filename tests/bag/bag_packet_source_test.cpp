@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "rigcal/bag/bag.hpp"
+#include "bag_error_of.hpp"
 #include "rigcal/bag/bag_error.hpp"
 #include "rigcal/bag/bag_packet_source.hpp"
 #include "rigcal/bag/packet_scan_message.hpp"
@@ -18,6 +19,8 @@
 
 namespace rigcal::bag {
 namespace {
+
+using test::bagErrorOf;
 
 using Payload = std::vector<std::uint8_t>;
 
@@ -132,26 +135,15 @@ TEST(BagPacketSource, Helios16pBagDecodesToThePcapsScans) {
   expectSameScans("robosense_helios16p", "robosense/helios16p.pcap", "RS-Helios-16P", "");
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const BagError& e) {
-    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a BagError";
-  return {};
-}
-
 TEST(BagPacketSource, TopicErrorsNameTheBagAndListWhatItHas) {
   RIGCAL_REQUIRE_DATA(xt32, "bags/nebula_xt32");
   RIGCAL_REQUIRE_DATA(talker, "bags/rosbag2/mcap_talker");
-  const std::string missing = errorOf([&] { BagPacketSource s(xt32, "/lidar/points"); });
+  const std::string missing = bagErrorOf([&] { BagPacketSource s(xt32, "/lidar/points"); });
   EXPECT_NE(missing.find("topic /lidar/points not in the bag; it has /pandar_packets"), std::string::npos) << missing;
-  const std::string wrong_type = errorOf([&] { BagPacketSource s(talker, "/topic"); });
+  const std::string wrong_type = bagErrorOf([&] { BagPacketSource s(talker, "/topic"); });
   EXPECT_NE(wrong_type.find("/topic has type std_msgs/msg/String, not a packet type"), std::string::npos)
       << wrong_type;
-  const std::string none = errorOf([&] { BagPacketSource s(talker); });
+  const std::string none = bagErrorOf([&] { BagPacketSource s(talker); });
   EXPECT_NE(none.find("no packet topic"), std::string::npos) << none;
 }
 
@@ -166,7 +158,7 @@ TEST(BagPacketSource, MessageShorterThanItsLayoutIsAnErrorNamingTheField) {
   ASSERT_GT(packets.size(), 1u);
   for (const std::size_t cut : {std::size_t(2), std::size_t(20), m->data.size() / 2, m->data.size() - 1}) {
     packets.clear();
-    const std::string e = errorOf(
+    const std::string e = bagErrorOf(
         [&] { decodePacketMessage(PacketMessageType::kPandarScan, m->data.first(cut), 0, "xt32 message", packets); });
     EXPECT_NE(e.find("xt32 message:"), std::string::npos) << e;
     EXPECT_TRUE(e.find("shorter than its layout") != std::string::npos || e.find("encapsulation") != std::string::npos)

@@ -12,11 +12,6 @@ namespace rigcal::test {
 namespace fs = std::filesystem;
 using bag::test::SqliteBagWriter;
 
-std::string readText(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 std::string topicOf(const std::string& sensor, const char* form) { return "/sensing/lidar/" + sensor + "/" + form; }
 
 std::string rigWithTopics(const std::string& rig, const char* form, const std::string& extrinsics) {
@@ -51,7 +46,7 @@ std::vector<std::string> simTopics(const config::RigConfig& rig, const char* for
 }
 
 std::vector<std::string> trajectoryRows(const fs::path& out) {
-  std::istringstream in(readText(out / "trajectory.csv"));
+  std::istringstream in(fileContents(out / "trajectory.csv"));
   std::vector<std::string> rows;
   for (std::string line; std::getline(in, line);)
     if (!line.empty() && line[0] != '#') rows.push_back(line);

@@ -15,7 +15,6 @@
 
 namespace rigcal::test {
 
-std::string readText(const std::filesystem::path& p);
 
 /// /sensing/lidar/<sensor>/<form>, the topics the BagPipeline recording's bags use.
 std::string topicOf(const std::string& sensor, const char* form);

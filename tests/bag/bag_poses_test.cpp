@@ -19,7 +19,7 @@ using bag::test::SqliteBagWriter;
 void writePoseTopics(SqliteBagWriter& bag, const fs::path& csv) {
   const int odom = bag.topic("/odom", "nav_msgs/msg/Odometry");
   const int tf = bag.topic("/tf", "tf2_msgs/msg/TFMessage");
-  std::istringstream in(readText(csv));
+  std::istringstream in(fileContents(csv));
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#') continue;
     std::istringstream row(line);

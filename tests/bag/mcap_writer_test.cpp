@@ -21,6 +21,8 @@
 namespace rigcal::bag {
 namespace {
 
+using rigcal::test::TempDir;
+
 using Bytes = std::vector<std::uint8_t>;
 
 struct Sent {
@@ -55,7 +57,7 @@ Bytes fileBytes(const std::filesystem::path& p) {
 class McapWriterRoundTrip : public testing::TestWithParam<Variant> {};
 
 TEST_P(McapWriterRoundTrip, EveryMessageReadsBackExactlyInLogTimeOrder) {
-  test::TempDir dir;
+  TempDir dir;
   const auto file = dir / "out.mcap";
   McapWriterOptions options;
   options.compression = GetParam().compression;
@@ -110,7 +112,7 @@ INSTANTIATE_TEST_SUITE_P(Variants, McapWriterRoundTrip,
 
 // Walks the written file record by record, as any MCAP reader would, and checks what the spec asks.
 TEST(McapWriter, FileStructureFollowsTheSpec) {
-  test::TempDir dir;
+  TempDir dir;
   const auto file = dir / "s.mcap";
   McapWriterOptions options;
   options.chunk_bytes = 1000;
@@ -204,7 +206,7 @@ TEST(McapWriter, FileStructureFollowsTheSpec) {
 }
 
 TEST(McapWriter, NothingAtTheNameWithoutClose) {
-  test::TempDir dir;
+  TempDir dir;
   {
     McapWriter writer(dir / "x.mcap");
     writer.write(writer.addChannel("/a", writer.addSchema("t/msg/T", "ros2msg", "")), 1, Bytes(3, 1));
@@ -214,7 +216,7 @@ TEST(McapWriter, NothingAtTheNameWithoutClose) {
 }
 
 TEST(McapWriter, RefusesWhatItCannotWrite) {
-  test::TempDir dir;
+  TempDir dir;
   McapWriterOptions lz4;
   lz4.compression = "lz4";
   EXPECT_THROW(McapWriter(dir / "a.mcap", lz4), std::invalid_argument);
@@ -224,7 +226,7 @@ TEST(McapWriter, RefusesWhatItCannotWrite) {
 }
 
 TEST(McapWriter, EmptyBagIsValid) {
-  test::TempDir dir;
+  TempDir dir;
   McapWriter(dir / "e.mcap").close();
   McapFile mcap(dir / "e.mcap");
   EXPECT_FALSE(mcap.next().has_value());
@@ -260,7 +262,7 @@ TEST_P(McapWriterCopiesRealBags, Identically) {
   }
   ASSERT_FALSE(original.empty());
   for (const Variant& v : {Variant{"zstd", true}, Variant{"", false}}) {
-    test::TempDir dir;
+    TempDir dir;
     McapWriterOptions options;
     options.compression = v.compression;
     options.summary = v.summary;

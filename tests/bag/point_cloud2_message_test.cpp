@@ -9,6 +9,7 @@
 #include <functional>
 
 #include "cdr_test_writer.hpp"
+#include "bag_error_of.hpp"
 #include "rigcal/bag/bag_error.hpp"
 #include "rigcal/bag/point_cloud2_message.hpp"
 #include "rigcal/bag/tf_message.hpp"
@@ -20,6 +21,8 @@
 
 namespace rigcal::bag {
 namespace {
+
+using test::bagErrorOf;
 
 using test::CdrWriter;
 
@@ -178,17 +181,6 @@ TEST(PointCloud2Message, WithoutATimeFieldEveryPointIsAtTheStamp) {
   for (auto o : cloud.scan.offset_ns) EXPECT_EQ(o, 0u);
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const BagError& e) {
-    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a BagError";
-  return {};
-}
-
 TEST(PointCloud2Message, MessagesShorterThanTheirLayoutAreOneLineErrors) {
   const Layout layout{"xyzi", {xyz("x", 0), xyz("y", 1), xyz("z", 2), kIntensityF32}, 0};
   std::vector<Point> points(50);
@@ -196,7 +188,7 @@ TEST(PointCloud2Message, MessagesShorterThanTheirLayoutAreOneLineErrors) {
   const auto message = writeCloud(layout, points, 0, 5, 0, &nans);
   for (std::size_t cut = 0; cut < message.size() - 1; cut += 7) {  // the trailing is_dense is optional to us
     const std::span<const std::uint8_t> part(message.data(), cut);
-    const std::string e = errorOf([&] { decodePointCloud2(part, "/points at 12"); });
+    const std::string e = bagErrorOf([&] { decodePointCloud2(part, "/points at 12"); });
     EXPECT_EQ(e.rfind("/points at 12: ", 0), 0u) << e;
   }
   // A consistent message whose data is shorter than height x row_step.
@@ -204,7 +196,7 @@ TEST(PointCloud2Message, MessagesShorterThanTheirLayoutAreOneLineErrors) {
   w.putHeader(0, "f").put(2u).put(2u).put(3u);
   for (const char* axis : {"x", "y", "z"}) w.putString(axis).put(std::uint32_t(axis[0] - 'x') * 4).put(std::uint8_t(kFloat32)).put(1u);
   w.put(std::uint8_t(0)).put(12u).put(24u).put(40u).putBytes(std::vector<std::uint8_t>(40)).put(std::uint8_t(1));
-  const std::string e = errorOf([&] { decodePointCloud2(w.bytes(), "short"); });
+  const std::string e = bagErrorOf([&] { decodePointCloud2(w.bytes(), "short"); });
   EXPECT_NE(e.find("short: message shorter than its layout: data holds 40 bytes, height 2 x row_step 24 needs 48"),
             std::string::npos) << e;
 }
@@ -228,7 +220,7 @@ TEST(TfMessage, TransformsReadBackWithFramesAndPose) {
   EXPECT_EQ(transforms[1].child_frame, "lidar_left");
   EXPECT_TRUE(transforms[1].T_parent_child.translation().isApprox(Eigen::Vector3d(0, 0.25, 0)));
   const auto part = std::span<const std::uint8_t>(w.bytes()).first(w.bytes().size() - 8);
-  const std::string e = errorOf([&] { decodeTfMessage(part, "/tf_static"); });
+  const std::string e = bagErrorOf([&] { decodeTfMessage(part, "/tf_static"); });
   EXPECT_NE(e.find("/tf_static: message shorter than its layout: field transforms[].transform.rotation"),
             std::string::npos) << e;
 }

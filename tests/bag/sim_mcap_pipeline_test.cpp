@@ -76,7 +76,7 @@ TEST(BagSimMcapLong, ParkingLotCalibratedFromItsMcapsAsFromItsPcap) {
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   const config::RigConfig rig = config::loadRigConfig(sim_dir / "rig.yaml");
   std::ofstream(sim_dir / "rig_from_bag.yaml") << std::regex_replace(
-      rigWithTopics(readText(sim_dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
+      rigWithTopics(fileContents(sim_dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
       std::regex("/sensing/lidar/(\\w+)/points"), "/$1/points");
   const auto calibrate = [&](const std::string& config, std::vector<std::string> input, const char* out) {
     std::vector<std::string> args{"calibrate", "--config", config, "--out", (dir / out).string()};

@@ -54,7 +54,7 @@ void simulateWithBags(const std::string& scenario, const fs::path& sim_dir, cons
   const auto sim = runRigcal(args);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   std::ofstream(sim_dir / "rig_from_bag.yaml") << std::regex_replace(
-      rigWithTopics(readText(sim_dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
+      rigWithTopics(fileContents(sim_dir / "rig.yaml"), "points", "initial_extrinsics: from_bag\n"),
       std::regex("/sensing/lidar/(\\w+)/points"), "/$1/points");
 }
 

@@ -35,7 +35,7 @@ struct Truth {
 Truth offsetGuess(const std::filesystem::path& sim) {
   const YAML::Node truth = YAML::LoadFile((sim / "truth.yaml").string())["sensors"]["top"]["T_base_sensor"];
   Truth t{truth["x"].as<double>(), truth["yaw"].as<double>()};
-  std::string rig = readText(sim / "rig.yaml");
+  std::string rig = fileContents(sim / "rig.yaml");
   const std::size_t at = rig.find("\n  top: {", rig.find("initial_extrinsics:"));
   EXPECT_NE(at, std::string::npos) << rig;
   if (at == std::string::npos) return t;
@@ -98,7 +98,7 @@ TEST(BaseFromMotionCli, TurnsBothWaysGiveYawAndX) {
   const auto& base = run.report["base_lidar"];
   EXPECT_EQ(base["sources"]["y"], "guess");
   EXPECT_EQ(base["sources"]["z"], "ground");
-  EXPECT_NE(readText(out / "calibration.yaml").find("top"), std::string::npos);
+  EXPECT_NE(fileContents(out / "calibration.yaml").find("top"), std::string::npos);
   const std::string& printed = run.calibrated.out;
   EXPECT_NE(printed.find("z, roll, pitch from the ground"), std::string::npos) << printed;
   EXPECT_NE(printed.find("from motion"), std::string::npos) << printed;

@@ -11,13 +11,6 @@
 
 namespace rigcal::test {
 
-std::string readText(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 nlohmann::json readJson(const std::filesystem::path& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
@@ -58,7 +51,7 @@ CommandResult compareWithTruth(const std::filesystem::path& sim_dir, const std::
 }
 
 std::string shortenedPreset(const std::string& preset, const std::string& segments, const std::string& parameters) {
-  std::string text = readText(std::filesystem::path(RIGCAL_SCENARIOS_DIR) / (preset + ".yaml"));
+  std::string text = fileContents(std::filesystem::path(RIGCAL_SCENARIOS_DIR) / (preset + ".yaml"));
   const std::size_t params = text.find("  parameters:\n");
   const std::size_t drive = text.find("  segments:\n");
   if (params == std::string::npos || drive == std::string::npos || params > drive) return {};

@@ -11,7 +11,6 @@
 
 namespace rigcal::test {
 
-std::string readText(const std::filesystem::path& path);
 nlohmann::json readJson(const std::filesystem::path& path);
 
 /// RIGCAL_LONG_TESTS=1 in an optimised build: the full-length presets run.

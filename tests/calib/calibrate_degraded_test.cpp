@@ -98,7 +98,7 @@ PcapFile damaged(const PcapFile& clean, const Row& row);
 /// calibration files are found relative to it).
 fs::path rigWithTimeOffset(const fs::path& sim, const std::string& sensor, const std::string& value,
                            const std::string& tag) {
-  std::string text = readText(sim / "rig.yaml");
+  std::string text = fileContents(sim / "rig.yaml");
   const auto entry = text.find("  - name: " + sensor + "\n");
   const auto ts = entry == std::string::npos ? entry : text.find("    time_source: ", entry);
   const auto eol = ts == std::string::npos ? ts : text.find('\n', ts);

@@ -87,7 +87,7 @@ TEST(CalibrateMemory, PeakRssOfAShortDriveStaysBounded) {
   const ChildUsage u = calibrateParkingLot(dir, {"--duration", "12"}, {"--deadline", "4"});
   // 0 ok, 6 unverified (a short deadline on a loaded machine): either way it calibrated and wrote its outputs.
   ASSERT_TRUE(u.exit_code == 0 || u.exit_code == 6)
-      << "exit " << u.exit_code << ": " << readText(dir / "calibrate.err");
+      << "exit " << u.exit_code << ": " << fileContents(dir / "calibrate.err");
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "calibration.yaml"));
   EXPECT_GT(u.peak_rss_kb, 0);
   EXPECT_LT(u.peak_rss_kb, kBoundKb) << "peak RSS " << u.peak_rss_kb / 1024 << " MB";
@@ -105,7 +105,7 @@ TEST(CalibrateMemoryLong, TheParkingLotDemoStaysUnder500Mb) {
   TempDir dir;
   const ChildUsage u = calibrateParkingLot(dir, {}, {});
   ASSERT_TRUE(u.exit_code == 0 || u.exit_code == 6)
-      << "exit " << u.exit_code << ": " << readText(dir / "calibrate.err");
+      << "exit " << u.exit_code << ": " << fileContents(dir / "calibrate.err");
   EXPECT_LT(u.peak_rss_kb, 500L * 1024) << "peak RSS " << u.peak_rss_kb / 1024 << " MB";
   RecordProperty("peak_rss_mb", static_cast<int>(u.peak_rss_kb / 1024));
 }

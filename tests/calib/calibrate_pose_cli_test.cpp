@@ -110,11 +110,6 @@ Pose poseOf(const YAML::Node& n) {
                      n["pitch"].as<double>(), n["yaw"].as<double>()});
 }
 
-std::string readText(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 // The whole chain through the real binary: `rigcal sim` writes a VLP-16 capture in the wire format,
 // the pose sensor's CSV (noisy, UTM-sized coordinates) and the truth; `rigcal calibrate-pose` decodes the
 // capture as rig.yaml says and must recover truth.yaml's T_pose_lidar and time offset.
@@ -122,7 +117,7 @@ TEST(CalibratePoseCli, RecoversTheSimulatedPoseScenarioFromItsPcap) {
   TempDir sim, out;
   std::vector<std::string> sim_args{"sim", "--scenario", "pose", "--out", sim.path().string()};
   if (RIGCAL_SANITIZED) {  // instrumented binaries: 5 s of the drive, the exit codes and files only
-    std::string text = readText(RIGCAL_POSE_SCENARIO);
+    std::string text = fileContents(RIGCAL_POSE_SCENARIO);
     text = text.substr(0, text.find("  segments:")) +
            "  segments:\n    - {type: accelerate, to_kmh: 6, duration: 2.0}\n"
            "    - {type: turn, turn_deg: 60, duration: 3.0}\n";
@@ -153,7 +148,7 @@ TEST(CalibratePoseCli, RecoversTheSimulatedPoseScenarioFromItsPcap) {
   const double dtime_ms = 1e3 * std::abs(got["time_offset_s"].as<double>() - offset_truth);
   std::cout << "calibrate-pose vs truth: " << dt_cm << " cm, " << dr_deg << " deg, " << dtime_ms << " ms\n";
 
-  const std::string text = readText(out / "calibration.txt");
+  const std::string text = fileContents(out / "calibration.txt");
   EXPECT_NE(text.find("Active Transformation Matrix from the Pose Sensor Frame to  the Lidar Frame:"),
             std::string::npos);
   EXPECT_NE(text.find("Time offset that must be added to lidar timestamps in seconds:"), std::string::npos);

@@ -39,7 +39,9 @@ using Clock = std::chrono::steady_clock;
 constexpr double kMaxCm = 1.0;
 constexpr double kMaxDeg = 0.05;
 
-std::string presetText(const std::string& name) { return readText(std::filesystem::path(RIGCAL_SCENARIOS_DIR) / (name + ".yaml")); }
+std::string presetText(const std::string& name) {
+  return fileContents(std::filesystem::path(RIGCAL_SCENARIOS_DIR) / (name + ".yaml"));
+}
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
@@ -145,7 +147,7 @@ TEST(CalibrateStatic, DegenerateBayIsReportedNotOk) {
   // Nothing the lidars see fixes the translation along the wall (the wall runs along y).
   const std::string weak = report["input"]["front_weak_directions"].get<std::string>();
   EXPECT_NE(weak.find('y'), std::string::npos) << weak;
-  EXPECT_NE(readText(dir / "out" / "calibration.yaml").find("unverified"), std::string::npos);
+  EXPECT_NE(fileContents(dir / "out" / "calibration.yaml").find("unverified"), std::string::npos);
 }
 
 // Also under the sanitizers (the capture's driver threads and the stillness check; no registration runs).
@@ -223,7 +225,7 @@ TEST(CalibrateStatic, FromTheBaysMcapAsFromItsPcap) {
   ASSERT_NO_FATAL_FAILURE(expectOkOrNamedDoubt(from_pcap, dir / "pcap"));
   // The bag's own way of naming things: each lidar's source.topic and frame, the initial extrinsics from
   // its /tf_static (the simulator writes the rig's guesses there); --topic overrides one of them.
-  std::string rig = readText(dir / "sim" / "rig.yaml");
+  std::string rig = fileContents(dir / "sim" / "rig.yaml");
   for (const char* lidar : {"top", "side_left", "side_right"})
     rig = std::regex_replace(rig, std::regex(std::string("(- name: ") + lidar + "\n    model: [^\n]+\n    source: \\{)"),
                              std::string("$1topic: /") + lidar + "/packets, frame: " + lidar + ", ");
@@ -266,7 +268,7 @@ TEST(CalibrateStatic, LiveFromSensorPortsOnLoopback) {
   ASSERT_NO_FATAL_FAILURE(simulate("calibration-bay", dir / "sim"));
   // Ports of this test's own (tests run in parallel); replay moves every destination port by the offset.
   const int offset = 20000 + int(::getpid() % 20000);
-  std::string rig = readText(dir / "sim" / "rig.yaml");
+  std::string rig = fileContents(dir / "sim" / "rig.yaml");
   for (const int port : {7502, 2368, 2369})
     rig = std::regex_replace(rig, std::regex("port: " + std::to_string(port) + ","), "port: " + std::to_string(port + offset) + ",");
   std::ofstream(dir / "sim" / "live.yaml") << rig;  // beside the vendor files it names

@@ -29,6 +29,8 @@ extern char** environ;
 namespace rigcal::drivers {
 namespace {
 
+using rigcal::test::fileContents;
+
 using Clock = std::chrono::steady_clock;
 using Bytes = std::vector<std::uint8_t>;
 
@@ -243,13 +245,6 @@ int waitExit(const Child& c) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-std::string slurp(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(ReplayCommand, RateOneTakesAboutTheCaptureDuration) {
   RIGCAL_REQUIRE_DATA(file, "velodyne/vlp16_20hz_veloview.pcap");
   const auto expected = readCapture(file, 2368);
@@ -265,8 +260,8 @@ TEST(ReplayCommand, RateOneTakesAboutTheCaptureDuration) {
   const int code = waitExit(child);
   const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
   reader.stop();
-  const std::string out = slurp(child.out);
-  ASSERT_EQ(code, 0) << out << slurp(child.err);
+  const std::string out = fileContents(child.out);
+  ASSERT_EQ(code, 0) << out << fileContents(child.err);
   EXPECT_NE(out.find("replayed " + std::to_string(expected.size()) + " packets"), std::string::npos) << out;
   std::cout << out << "wall " << wall << " s for a capture span of " << toSeconds(span) << " s\n";
   EXPECT_GE(wall, toSeconds(span));
@@ -294,8 +289,8 @@ TEST(ReplayCommand, LoopRunsUntilInterruptedAndSummarises) {
   kill(child.pid, SIGINT);
   const int code = waitExit(child);
   reader.stop();
-  const std::string out = slurp(child.out);
-  EXPECT_EQ(code, 130) << out << slurp(child.err);
+  const std::string out = fileContents(child.out);
+  EXPECT_EQ(code, 130) << out << fileContents(child.err);
   EXPECT_NE(out.find("replayed "), std::string::npos) << out;
   EXPECT_GE(received.size(), 3u * 64u) << "several passes of 64 datagrams in 0.8 s";
   const auto expected = readCapture(file, 7502);
@@ -309,18 +304,18 @@ TEST(ReplayCommand, RefusesRemoteTargetsAndBadRates) {
   test::TempDir dir;
   Child child = spawnRigcal(dir, {"replay", file.string(), "--to", "192.0.2.1"});
   EXPECT_EQ(waitExit(child), 2);
-  std::string err = slurp(child.err);
+  std::string err = fileContents(child.err);
   EXPECT_NE(err.find("192.0.2.1 is outside 127.0.0.0/8"), std::string::npos) << err;
   EXPECT_NE(err.find("--allow-remote"), std::string::npos) << err;
 
   child = spawnRigcal(dir, {"replay", file.string(), "--to", "127.0.0.1", "--rate", "fast"});
   EXPECT_EQ(waitExit(child), 2);
-  err = slurp(child.err);
+  err = fileContents(child.err);
   EXPECT_NE(err.find("--rate: 'fast'"), std::string::npos) << err;
 
   child = spawnRigcal(dir, {"replay", (dir / "missing.pcap").string(), "--to", "127.0.0.1"});
   EXPECT_EQ(waitExit(child), 4);
-  err = slurp(child.err);
+  err = fileContents(child.err);
   EXPECT_NE(err.find("missing.pcap"), std::string::npos) << err;
 }
 

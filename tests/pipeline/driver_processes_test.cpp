@@ -40,13 +40,6 @@ constexpr bool kRealTime = !RIGCAL_SANITIZED;
 bool wholeRecording() { return std::getenv("RIGCAL_LONG_TESTS") != nullptr && !RIGCAL_SANITIZED; }
 const std::vector<std::string> kSensors = {"top", "front_left", "front_right"};
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 /// The simulator's rig.yaml for the receiving side: ports moved by `offset` (away from other tests),
 /// no source address (loopback packets come from 127.0.0.1), and a frame budget this short drive fills.
 fs::path receiverRig(const fs::path& sim_dir, int offset) {
@@ -179,7 +172,7 @@ TEST(PipelineProcesses, SimReplayedAt1xIntoDriverProcessesAndMapOverShmDropsNoth
 
   // Zero dropped scans: every published scan reached the pipeline (no ring overrun) and no stage dropped one.
   // Under sanitizers real time is out of reach: what arrived is still accounted for, never invented.
-  const auto stats = nlohmann::json::parse(slurp(dir / "stats.json"));
+  const auto stats = nlohmann::json::parse(fileContents(dir / "stats.json"));
   if (kRealTime) {
     EXPECT_EQ(stats["input_dropped_scans"].get<std::uint64_t>(), 0u);
     for (const auto& q : stats["queues"]) EXPECT_EQ(q["dropped"].get<std::uint64_t>(), 0u) << q["name"];
@@ -213,7 +206,7 @@ TEST(PipelineProcesses, SimReplayedAt1xIntoDriverProcessesAndMapOverShmDropsNoth
       EXPECT_GT(p.selected[s], 0u) << s << ": no pairing passed the interpolation criteria";
     }
   }
-  const std::string trajectory = slurp(dir / "map" / "trajectory.csv");
+  const std::string trajectory = fileContents(dir / "map" / "trajectory.csv");
   // Every mapping scan is in the trajectory but the partial sweeps at the ends: the replay starts
   // mid-rotation (the mapper never seeds the map with a partial sweep) and the drivers stop mid-rotation
   // (their last, flushed sweep is skipped when it holds fewer than min_mapping_pointcloud_size points).

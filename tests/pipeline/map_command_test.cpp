@@ -11,13 +11,6 @@
 namespace rigcal::test {
 namespace {
 
-std::string readAll(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::filesystem::path writeRig(const TempDir& dir) {
   const auto rig = dir / "rig.yaml";
   std::ofstream(rig) << "rig: hdl32-test\n"
@@ -42,7 +35,7 @@ TEST(MapCommand, MapsARealCaptureAndWritesItsOutputs) {
   EXPECT_NE(r.out.find("wrote trajectory.csv"), std::string::npos) << r.out;
 
   // One line per registered scan after the header (the capture holds 7 whole or partial sweeps).
-  std::istringstream csv(readAll(out / "trajectory.csv"));
+  std::istringstream csv(fileContents(out / "trajectory.csv"));
   std::string line;
   int rows = 0;
   while (std::getline(csv, line))
@@ -51,7 +44,7 @@ TEST(MapCommand, MapsARealCaptureAndWritesItsOutputs) {
   const PointTable map = readPcd(out / "map.pcd");
   EXPECT_GT(map.size(), 10000u);
   EXPECT_TRUE(std::filesystem::exists(out / "selection.txt"));
-  const std::string json = readAll(dir / "stats.json");
+  const std::string json = fileContents(dir / "stats.json");
   EXPECT_EQ(json.front(), '{');
   EXPECT_NE(json.find("\"name\": \"mapper\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"dropped\": 0"), std::string::npos) << json;  // offline: lossless

@@ -12,7 +12,7 @@
 namespace rigcal::pipeline {
 namespace {
 
-constexpr TimeNs kPeriod = 100 * kNsPerMs;
+constexpr TimeNs kLidarPeriod = 100 * kNsPerMs;
 
 TEST(PairingLane, ASilentLidarsLastScanIsPairedOnceNotWithEveryKeyframeOfTheGap) {
   config::Parameters params;
@@ -22,7 +22,7 @@ TEST(PairingLane, ASilentLidarsLastScanIsPairedOnceNotWithEveryKeyframeOfTheGap)
   std::vector<MappingFrame> frames(100);
   for (int i = 0; i < 100; ++i) {
     frames[i].sequence = std::uint64_t(i);
-    frames[i].stamp_ns = i * kPeriod;
+    frames[i].stamp_ns = i * kLidarPeriod;
     frames[i].path_length = 0.1 * i;  // 1 m/s along x
     frames[i].T_map_lidar = fromXyzRpy({0.1 * i, 0, 0, 0, 0, 0});
     frames[i].kind = FrameKind::kFrame;
@@ -41,7 +41,7 @@ TEST(PairingLane, ASilentLidarsLastScanIsPairedOnceNotWithEveryKeyframeOfTheGap)
   for (int i = 0; i < 15; ++i) {
     auto scan = std::make_shared<Scan>();
     scan->sequence = std::uint64_t(i);
-    scan->stamp_ns = i * kPeriod + 3 * kNsPerMs;
+    scan->stamp_ns = i * kLidarPeriod + 3 * kNsPerMs;
     lane.addScan({scan, scan, 0});
   }
   std::vector<CandidateMessage> out;
@@ -71,7 +71,7 @@ TEST(PairingLane, ACandidatesCroppedCloudKeepsPositionsOnly) {
   std::vector<MappingFrame> frames(30);
   for (int i = 0; i < 30; ++i) {
     frames[i].sequence = std::uint64_t(i);
-    frames[i].stamp_ns = i * kPeriod;
+    frames[i].stamp_ns = i * kLidarPeriod;
     frames[i].path_length = 0.1 * i;
     frames[i].T_map_lidar = fromXyzRpy({0.1 * i, 0, 0, 0, 0, 0});
     frames[i].kind = i == 10 ? FrameKind::kKeyframe : FrameKind::kFrame;
@@ -84,7 +84,7 @@ TEST(PairingLane, ACandidatesCroppedCloudKeepsPositionsOnly) {
   for (int i = 8; i < 14; ++i) {
     auto scan = std::make_shared<Scan>();
     scan->sequence = std::uint64_t(i);
-    scan->stamp_ns = i * kPeriod + 3 * kNsPerMs;
+    scan->stamp_ns = i * kLidarPeriod + 3 * kNsPerMs;
     // 1000 points 2-10 m away (kept), 1000 within 1 m (cropped by min_calibration_range).
     for (int j = 0; j < 2000; ++j) {
       const double r = j < 1000 ? 2.0 + 0.008 * j : 0.5;

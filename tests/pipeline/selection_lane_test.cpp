@@ -21,13 +21,13 @@ constexpr int kFramesPerKeyframe = 10;  // a keyframe, then 9 ordinary stored fr
 
 /// A drive of stored mapping frames (one every 10 cm, a keyframe every metre) and the store of their
 /// clouds, which the test can drop as the pipeline does once no future candidate needs them.
-struct Drive {
+struct StoredDrive {
   config::Parameters params;
   std::shared_ptr<const std::vector<MappingFrame>> frames;
   std::vector<std::shared_ptr<const Scan>> store;
   std::vector<std::weak_ptr<const Scan>> watched;  // every cloud, to see which ones are still held
 
-  Drive() {
+  StoredDrive() {
     params.lidar_calibration_max_frames = 2;
     params.calibration_min_distance_between_frames = 5.0;
     auto f = std::make_shared<std::vector<MappingFrame>>();
@@ -84,7 +84,7 @@ struct Drive {
 };
 
 TEST(SelectionLane, ACandidateKeepsOnlyTheCloudsItsTargetWouldBeBuiltFrom) {
-  Drive drive;
+  StoredDrive drive;
   SelectionLane lane("top", "front", Pose::Identity(), Pose::Identity(), drive.params);
   // Keyframe 15's window is keyframes 5..25: 201 stored frames, of which it keeps keyframes 6, 8, .., 24
   // (every other one) and its own.
@@ -98,7 +98,7 @@ TEST(SelectionLane, ACandidateKeepsOnlyTheCloudsItsTargetWouldBeBuiltFrom) {
 }
 
 TEST(SelectionLane, NeighbouringCandidatesShareTheirClouds) {
-  Drive drive;
+  StoredDrive drive;
   drive.params.lidar_calibration_max_frames = 10;  // none is handed over: the lane holds all three
   SelectionLane lane("top", "front", Pose::Identity(), Pose::Identity(), drive.params);
   for (const int k : {14, 15, 16}) ASSERT_EQ(lane.add(drive.candidate(k, true, 1.0), drive.lookup()), nullptr);
@@ -109,7 +109,7 @@ TEST(SelectionLane, NeighbouringCandidatesShareTheirClouds) {
 }
 
 TEST(SelectionLane, ACandidateThatCanNeverBeSelectedKeepsNoScanNorCloud) {
-  Drive drive;
+  StoredDrive drive;
   SelectionLane lane("top", "front", Pose::Identity(), Pose::Identity(), drive.params);
   CandidateMessage rejected = drive.candidate(12, false, 1.0);  // its pairing failed the criteria
   CandidateMessage flat = drive.candidate(14, true, 0.1);       // below calibration_min_pca_eigenvalue
@@ -125,7 +125,7 @@ TEST(SelectionLane, ACandidateThatCanNeverBeSelectedKeepsNoScanNorCloud) {
 }
 
 TEST(SelectionLane, TheHandOverCarriesEachSelectedFramesPicksAndTheLaneKeepsNothing) {
-  Drive drive;
+  StoredDrive drive;
   SelectionLane lane("top", "front", Pose::Identity(), Pose::Identity(), drive.params);
   CandidateMessage later_flat = drive.candidate(20, true, 0.1);
   const std::weak_ptr<const Scan> unselected_raw = later_flat.raw;

@@ -7,24 +7,18 @@
 
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/sim/outputs.hpp"
+#include "sim_test_util.hpp"
 #include "test_data.hpp"
 
 namespace rigcal::sim {
 namespace {
 
+using test::poseFrom;
+
+using rigcal::test::TempDir;
+using rigcal::test::fileContents;
+
 namespace fs = std::filesystem;
-
-Pose poseFrom(const YAML::Node& n) {
-  return fromXyzRpy({n["x"].as<double>(), n["y"].as<double>(), n["z"].as<double>(), n["roll"].as<double>(),
-                     n["pitch"].as<double>(), n["yaw"].as<double>()});
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 void writeAll(const Simulation& sim, const fs::path& dir) {
   writeTruthYaml(sim, dir / "truth.yaml");
@@ -34,7 +28,7 @@ void writeAll(const Simulation& sim, const fs::path& dir) {
 
 TEST(Outputs, TruthIsConsistent) {
   const Simulation sim(loadScenario("street"));
-  test::TempDir dir;
+  TempDir dir;
   writeTruthYaml(sim, dir / "truth.yaml");
   const YAML::Node t = YAML::LoadFile((dir / "truth.yaml").string());
   EXPECT_EQ(t["scenario"].as<std::string>(), "street");
@@ -60,7 +54,7 @@ TEST(Outputs, TruthIsConsistent) {
 
 TEST(Outputs, PoseScenarioTruthGivesTheLidarAlignAnswer) {
   const Simulation sim(loadScenario("pose"));
-  test::TempDir dir;
+  TempDir dir;
   writeTruthYaml(sim, dir / "truth.yaml");
   const YAML::Node t = YAML::LoadFile((dir / "truth.yaml").string());
   const YAML::Node l = t["pose_sensor"]["lidars"]["lidar"];
@@ -75,7 +69,7 @@ TEST(Outputs, RigYamlLoadsAndIsPerturbedByExactlyTheConfiguredAmount) {
     Scenario sc = loadScenario("street");
     sc.perturbation = {0.3, 5.0, perturb_mapping};
     const Simulation sim(sc);
-    test::TempDir dir;
+    TempDir dir;
     const auto files = writeRigFiles(sim, dir.path());
     EXPECT_EQ(files.size(), sc.sensors.size() + 1);
     const config::RigConfig rig = config::loadRigConfig(dir / "rig.yaml");  // throws on any mistake
@@ -103,7 +97,7 @@ TEST(Outputs, RigYamlLoadsAndIsPerturbedByExactlyTheConfiguredAmount) {
 
 TEST(Outputs, VendorFilesCarryTheSimulatedAngles) {
   const Simulation sim(loadScenario("street"));
-  test::TempDir dir;
+  TempDir dir;
   writeRigFiles(sim, dir.path());
   const YAML::Node ouster = YAML::LoadFile((dir / "front.json").string());
   const LidarModel& os = lidarModel("OS1-64");
@@ -127,7 +121,7 @@ TEST(Outputs, VendorFilesCarryTheSimulatedAngles) {
 
 TEST(Outputs, PosesCsvIsTheLidarAlignLayout) {
   const Simulation sim(loadScenario("pose"));
-  test::TempDir dir;
+  TempDir dir;
   writePosesCsv(sim, dir / "poses.csv");
   std::ifstream in(dir / "poses.csv");
   std::string line;
@@ -162,12 +156,12 @@ TEST(Outputs, PosesCsvIsTheLidarAlignLayout) {
 }
 
 TEST(Outputs, SameSeedGivesByteIdenticalFilesAndAnotherSeedAnotherWorld) {
-  test::TempDir a, b, c;
+  TempDir a, b, c;
   writeAll(Simulation(loadScenario("parking-lot")), a.path());
   writeAll(Simulation(loadScenario("parking-lot")), b.path());
   std::size_t compared = 0;
   for (const auto& e : fs::directory_iterator(a.path())) {
-    EXPECT_EQ(slurp(e.path()), slurp(b / e.path().filename().string())) << e.path().filename();
+    EXPECT_EQ(fileContents(e.path()), fileContents(b / e.path().filename().string())) << e.path().filename();
     ++compared;
   }
   EXPECT_EQ(compared, 6u);  // truth, poses, rig, and three sensor files
@@ -175,8 +169,8 @@ TEST(Outputs, SameSeedGivesByteIdenticalFilesAndAnotherSeedAnotherWorld) {
   other.seed = 99;
   const Simulation s1(loadScenario("parking-lot")), s2(other);
   writeAll(s2, c.path());
-  EXPECT_NE(slurp(a / "truth.yaml"), slurp(c / "truth.yaml"));
-  EXPECT_NE(slurp(a / "rig.yaml"), slurp(c / "rig.yaml"));
+  EXPECT_NE(fileContents(a / "truth.yaml"), fileContents(c / "truth.yaml"));
+  EXPECT_NE(fileContents(a / "rig.yaml"), fileContents(c / "rig.yaml"));
   // A different world: the scene's primitives are not where they were.
   const auto& b1 = s1.scene().content().boxes;
   const auto& b2 = s2.scene().content().boxes;

@@ -9,6 +9,8 @@
 namespace rigcal::sim {
 namespace {
 
+using rigcal::test::TempDir;
+
 std::vector<std::uint8_t> pattern(std::size_t n, std::uint8_t seed) {
   std::vector<std::uint8_t> v(n);
   for (std::size_t i = 0; i < n; ++i) v[i] = std::uint8_t(seed + i * 7 + (i >> 8));
@@ -41,7 +43,7 @@ std::vector<std::pair<TimeNs, std::vector<std::uint8_t>>> readFrames(const std::
 }
 
 TEST(PcapWriter, RoundTripThroughPcapSourceIncludingFragments) {
-  test::TempDir dir;
+  TempDir dir;
   const auto file = dir / "out.pcap";
   const NetEndpoint a = endpoint("10.5.5.87", 7502), b = endpoint("192.168.1.201", 2368);
   const NetEndpoint host = endpoint("10.5.5.100", 7502), bcast{0xffffffffu, 2368, {0xff, 0xff, 0xff, 0xff, 0xff, 0xff}};
@@ -79,7 +81,7 @@ TEST(PcapWriter, RoundTripThroughPcapSourceIncludingFragments) {
 }
 
 TEST(PcapWriter, FramesHaveValidHeadersChecksumsAndFragmentOffsets) {
-  test::TempDir dir;
+  TempDir dir;
   const auto file = dir / "frag.pcap";
   {
     PcapWriter w(file);
@@ -145,7 +147,7 @@ TEST(NicClock, StampsAreLateJitteredAndMonotonic) {
 }
 
 TEST(RecordingWriter, MergesSensorsInTrueSendOrderAcrossClockOffsets) {
-  test::TempDir dir;
+  TempDir dir;
   const auto file = dir / "rec.pcap";
   // Sensor 1's clock runs 5 ms ahead: its packet stamped 11 ms was sent at true 6 ms.
   RecordingSensor s0{endpoint("10.5.5.87", 7502), endpoint("10.5.5.100", 7502), 0};

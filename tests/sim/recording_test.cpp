@@ -13,6 +13,8 @@
 namespace rigcal::sim {
 namespace {
 
+using rigcal::test::TempDir;
+
 class SequenceEncoder : public PacketEncoder {
  public:
   SequenceEncoder(std::uint8_t sensor, std::size_t per_packet, std::size_t padding)
@@ -60,7 +62,7 @@ trajectory: {segments: [{type: stop, duration: 0.3}]}
   std::vector<std::unique_ptr<PacketEncoder>> enc;
   enc.push_back(std::make_unique<SequenceEncoder>(0, 16, 6000));  // Ouster-sized: fragmented
   enc.push_back(std::make_unique<SequenceEncoder>(1, 24, 1000));
-  test::TempDir dir;
+  TempDir dir;
   SimulationOptions o;
   o.chunk_ns = 20 * kNsPerMs;
   const RecordingResult r = writeRecording(sim, std::move(enc), dir / "rec.pcap", o);
@@ -102,7 +104,7 @@ TEST(Recording, RefusesMissingEncoders) {
   auto encoders = makeEncoders(sim);
   ASSERT_EQ(encoders.size(), 1u);
   encoders[0].reset();  // as if its model had no encoder
-  test::TempDir dir;
+  TempDir dir;
   EXPECT_THROW(writeRecording(sim, std::move(encoders), dir / "x.pcap", {}), std::invalid_argument);
   EXPECT_FALSE(std::filesystem::exists(dir / "x.pcap"));
 }

@@ -16,17 +16,15 @@
 namespace rigcal::sim {
 namespace {
 
+using test::poseFrom;
+
+using rigcal::test::TempDir;
+using rigcal::test::fileContents;
+
 namespace fs = std::filesystem;
 
 // Short drives keep the tests fast; sanitizer builds shorter still.
 constexpr double kDriveSeconds = RIGCAL_SANITIZED ? 0.15 : 0.6;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 struct Generated {
   RecordingResult result;
@@ -64,7 +62,7 @@ class RoundTrip : public ::testing::TestWithParam<ModelCase> {};
 TEST_P(RoundTrip, DecodersGiveBackTheSimulatedPointsWithinQuantisation) {
   const ModelCase c = GetParam();
   const Simulation sim(test::movingLidar(c.model, 8.0, 20.0, 0.02, 0.02, kDriveSeconds + 0.2));
-  rigcal::test::TempDir dir;
+  TempDir dir;
   const Generated g = generate(sim, dir.path(), fromSeconds(kDriveSeconds));
   ASSERT_GT(g.result.datagrams, 0u);
   const test::SensorRoundTrip r =
@@ -99,17 +97,12 @@ INSTANTIATE_TEST_SUITE_P(Models, RoundTrip,
 
 TEST(RoundTripCapture, SameSeedGivesAByteIdenticalCaptureWhateverTheThreads) {
   const Simulation sim(test::movingLidar("VLP-16", 8.0, 0.0, 0.02, 0.02, 0.5));
-  rigcal::test::TempDir a, b;
+  TempDir a, b;
   generate(sim, a.path(), fromSeconds(0.2), 2);
   generate(sim, b.path(), fromSeconds(0.2), 1);
-  const std::string pa = slurp(a / "recording.pcap"), pb = slurp(b / "recording.pcap");
+  const std::string pa = fileContents(a / "recording.pcap"), pb = fileContents(b / "recording.pcap");
   EXPECT_GT(pa.size(), 100'000u);
   EXPECT_TRUE(pa == pb) << "same seed, same bytes";
-}
-
-Pose poseFrom(const YAML::Node& n) {
-  return fromXyzRpy({n["x"].as<double>(), n["y"].as<double>(), n["z"].as<double>(), n["roll"].as<double>(),
-                     n["pitch"].as<double>(), n["yaw"].as<double>()});
 }
 
 // A sensor outage: the sensor sends nothing for 0.1 s. The decoders see the packets as lost (Velodyne
@@ -127,7 +120,7 @@ TEST(RoundTripCapture, AnOutageIsSeenAsLostPacketsByEveryVendor) {
                                           "  start: {x: -20, y: -6, speed_kmh: 6}\n  segments: [{type: cruise, duration: 0.5}]\n",
                                       "outage");
     const Simulation sim(sc);
-    rigcal::test::TempDir dir;
+    TempDir dir;
     const Generated g = generate(sim, dir.path(), fromSeconds(kOutageFrom + 0.25));
     const test::SensorRoundTrip r =
         test::decodeAndCompare(sim, 0, dir.path(), dir / "recording.pcap", g.recorder->sensors[0], 0.02);
@@ -145,7 +138,7 @@ TEST(RoundTripCapture, OusterLegacyProfile) {
   Scenario sc = test::movingLidar("OS1-64", 8.0, 10.0, 0.02, 0.02, kDriveSeconds + 0.2);
   sc.sensors[0].ouster_legacy = true;
   const Simulation sim(sc);
-  rigcal::test::TempDir dir;
+  TempDir dir;
   const Generated g = generate(sim, dir.path(), fromSeconds(kDriveSeconds));
   const test::SensorRoundTrip r =
       test::decodeAndCompare(sim, 0, dir.path(), dir / "recording.pcap", g.recorder->sensors[0], 0.001);
@@ -166,7 +159,7 @@ TEST(RoundTripCapture, OusterLegacyProfile) {
 // clock − clock offset), and not by much more than the packet's own duration.
 TEST(RoundTripCapture, CaptureStampsFollowTheLastFiringOfEachPacket) {
   const Simulation sim(loadScenario("street"));
-  rigcal::test::TempDir dir;
+  TempDir dir;
   generate(sim, dir.path(), fromSeconds(RIGCAL_SANITIZED ? 0.1 : 0.25));
   std::map<std::pair<std::uint32_t, std::uint16_t>, std::size_t> sensor_of;
   std::vector<std::unique_ptr<drivers::PacketDecoder>> decoders;
@@ -204,7 +197,7 @@ TEST(RoundTripCapture, CaptureStampsFollowTheLastFiringOfEachPacket) {
 // each sensor's decoder gives back its simulated points; truth.yaml composes.
 TEST(RoundTripCapture, EverySensorOfAPresetFromItsOwnSourceAndDecodable) {
   const Simulation sim(loadScenario("street"));
-  rigcal::test::TempDir dir;
+  TempDir dir;
   const Generated g = generate(sim, dir.path(), fromSeconds(RIGCAL_SANITIZED ? 0.15 : 0.35));
   const std::map<std::string, std::size_t> packet_size = {
       {"VLS-128", 1206}, {"VLP-16", 1206}, {"VLP-32C", 1206}, {"OS1-64", 12544}, {"OS1-128", 24832}, {"PandarXT32", 1080}};

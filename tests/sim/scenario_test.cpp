@@ -13,6 +13,9 @@
 namespace rigcal::sim {
 namespace {
 
+using rigcal::test::TempDir;
+using rigcal::test::rigcalBinary;
+
 std::vector<std::string> modelsOf(const Scenario& s) {
   std::vector<std::string> m;
   for (const auto& x : s.sensors) m.push_back(x.model);
@@ -105,7 +108,7 @@ TEST(Scenario, OusterUdpProfile) {
 }
 
 TEST(Scenario, LoadsAFileByPath) {
-  test::TempDir dir;
+  TempDir dir;
   std::ofstream(dir / "mine.yaml") << "scenario: mine\nrig:\n  mapping_lidar: a\n  sensors:\n"
                                       "    - {name: a, model: PandarXT32, address: 10.0.0.2, port: 2368, extrinsic: {z: 2}}\n"
                                       "scene: {layout: street}\ntrajectory:\n  segments: [{type: stop, duration: 1}]\n";
@@ -115,7 +118,7 @@ TEST(Scenario, LoadsAFileByPath) {
 }
 
 std::pair<int, std::string> runRigcal(const std::string& args) {
-  const std::string cmd = test::rigcalBinary().string() + " " + args + " 2>&1";
+  const std::string cmd = rigcalBinary().string() + " " + args + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   std::string out;
   std::array<char, 512> buf{};
@@ -125,7 +128,7 @@ std::pair<int, std::string> runRigcal(const std::string& args) {
 }
 
 TEST(SimCommand, WritesTruthPosesRigAndACaptureThatDecodeAndCheckConfigRead) {
-  test::TempDir dir;
+  TempDir dir;
   // Two lidars of different vendors, a short drive: rig.yaml names each one's calibration/metadata
   // file, and `rigcal decode` / `rigcal check-config` work on the output folder as it is.
   std::ofstream(dir / "two.yaml") << "scenario: two\nseed: 5\nrig:\n  mapping_lidar: top\n  calibration_lidars: [side]\n"
@@ -161,7 +164,7 @@ TEST(SimCommand, WritesTruthPosesRigAndACaptureThatDecodeAndCheckConfigRead) {
 }
 
 TEST(SimCommand, DumpsSweepsAsPcd) {
-  test::TempDir dir;
+  TempDir dir;
   std::ofstream(dir / "short.yaml") << "scenario: short\nrig:\n  mapping_lidar: a\n  sensors:\n"
                                        "    - {name: a, model: VLP-16, address: 10.0.0.2, port: 2368, extrinsic: {z: 2}}\n"
                                        "scene: {layout: parking-lot}\ntrajectory:\n"

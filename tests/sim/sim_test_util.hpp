@@ -1,7 +1,10 @@
 #pragma once
 // Small scenarios for the simulator's tests: fast to simulate, deterministic, with knobs.
+#include <yaml-cpp/yaml.h>
+
 #include <string>
 
+#include "rigcal/core/pose.hpp"
 #include "rigcal/sim/scenario.hpp"
 
 namespace rigcal::sim::test {
@@ -27,6 +30,12 @@ noise: {range_sigma_m: )" + std::to_string(range_sigma) + R"(, dropout: )" + std
                            R"(, intensity_sigma: 0}
 )";
   return parseScenario(text, "test scenario");
+}
+
+/// A pose written as {x, y, z, roll, pitch, yaw} (metres, radians), as truth.yaml holds it.
+inline Pose poseFrom(const YAML::Node& n) {
+  return fromXyzRpy({n["x"].as<double>(), n["y"].as<double>(), n["z"].as<double>(), n["roll"].as<double>(),
+                     n["pitch"].as<double>(), n["yaw"].as<double>()});
 }
 
 }  // namespace rigcal::sim::test

@@ -4,6 +4,8 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 
 namespace rigcal::test {
@@ -35,6 +37,11 @@ std::filesystem::path rigcalBinary() {
   const char* bin = std::getenv("RIGCAL_BIN");
   if (!bin || !*bin) throw std::runtime_error("RIGCAL_BIN is not set (run the tests through ctest)");
   return bin;
+}
+
+std::string fileContents(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
 }
 
 }  // namespace rigcal::test

@@ -28,6 +28,9 @@ class TempDir {
 /// The rigcal executable under test ($RIGCAL_BIN, set by ctest).
 std::filesystem::path rigcalBinary();
 
+/// A file's bytes; empty when it cannot be read (a test then fails on what it expected to find).
+std::string fileContents(const std::filesystem::path& file);
+
 }  // namespace rigcal::test
 
 /// Resolves `relative` under dataDir() into `var`; skips the test (fails under CI) when it is absent.

@@ -14,6 +14,7 @@ namespace rigcal::drivers::hesai {
 namespace {
 
 using hesai_test::Capture;
+using hesai_test::firstPayload;
 using hesai_test::loadCapture;
 
 struct NewModel {
@@ -34,13 +35,6 @@ const ModelSpec& spec(const char* name) {
   const ModelSpec* s = findModel(name);
   EXPECT_NE(s, nullptr) << name;
   return *s;
-}
-
-std::vector<std::uint8_t> firstPayload(const std::filesystem::path& file) {
-  PcapSource source(file);
-  auto p = source.next();
-  if (!p) return {};
-  return {p->payload.begin(), p->payload.end()};
 }
 
 TEST(HesaiMoreModels, RealPacketsParseWithTheirTailFields) {

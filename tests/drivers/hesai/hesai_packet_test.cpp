@@ -12,17 +12,12 @@
 namespace rigcal::drivers::hesai {
 namespace {
 
+using hesai_test::firstPayload;
+
 const ModelSpec& model(const char* name) {
   const ModelSpec* spec = findModel(name);
   EXPECT_NE(spec, nullptr) << name;
   return *spec;
-}
-
-std::vector<std::uint8_t> firstPayload(const std::filesystem::path& file) {
-  PcapSource source(file);
-  auto p = source.next();
-  if (!p) return {};
-  return {p->payload.begin(), p->payload.end()};
 }
 
 TEST(HesaiPacket, ModelsAndReturnModes) {

@@ -11,12 +11,7 @@
 namespace rigcal::drivers::velodyne {
 namespace {
 
-std::string readText(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using rigcal::test::fileContents;
 
 std::filesystem::path writeText(const test::TempDir& dir, const std::string& name, const std::string& text) {
   const auto path = dir / name;
@@ -114,7 +109,7 @@ TEST(VelodyneCalibration, UnknownModelIsNamed) {
 TEST(VelodyneCalibration, MalformedYamlIsRejectedNamingFileAndField) {
   RIGCAL_REQUIRE_DATA(dir, "velodyne");
   const test::TempDir tmp;
-  const std::string good = readText(dir / "VLP16.calibration.yaml");
+  const std::string good = fileContents(dir / "VLP16.calibration.yaml");
 
   // A laser without its elevation.
   std::string missing = good;
@@ -162,7 +157,7 @@ TEST(VelodyneCalibration, MalformedYamlIsRejectedNamingFileAndField) {
 TEST(VelodyneCalibration, MalformedXmlIsRejectedNamingFileAndField) {
   RIGCAL_REQUIRE_DATA(dir, "velodyne");
   const test::TempDir tmp;
-  const std::string good = readText(dir / "VLP-16.xml");
+  const std::string good = fileContents(dir / "VLP-16.xml");
 
   // One laser entry without its elevation.
   std::string missing = good;
