@@ -1,25 +1,20 @@
 #pragma once
-// Test clients of the view server on real loopback sockets: one HTTP request, and a WebSocket client
-// (Boost.Beast) that reads messages with a timeout.
-#include <boost/asio/connect.hpp>
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/beast/core.hpp>
-#include <boost/beast/http.hpp>
-#include <boost/beast/websocket.hpp>
+// Test clients of the view server on real loopback sockets: one HTTP request, and a WebSocket client that
+// reads messages with a timeout. Boost.Beast stays in view_client.cpp, compiled once for every view test.
+#include <boost/system/system_error.hpp>
 
 #include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
-#include <thread>
 
 #include "rigcal/view/view_server.hpp"
 
 namespace rigcal::view::test {
 
-namespace beast = boost::beast;
-namespace http = beast::http;
-namespace websocket = beast::websocket;
-using tcp = boost::asio::ip::tcp;
+enum class HttpMethod { kGet, kHead, kPost, kPut, kDelete };
 
 struct HttpResult {
   int status = 0;
@@ -28,24 +23,7 @@ struct HttpResult {
 };
 
 /// `method target` sent verbatim (the target is not normalised: traversal attempts reach the server as typed).
-inline HttpResult httpRequest(std::uint16_t port, const std::string& target, http::verb method = http::verb::get) {
-  boost::asio::io_context io;
-  beast::tcp_stream stream(io);
-  stream.connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
-  stream.expires_after(std::chrono::seconds(10));
-  http::request<http::string_body> req(method, target, 11);
-  req.set(http::field::host, "127.0.0.1");
-  http::write(stream, req);
-  beast::flat_buffer buffer;
-  http::response_parser<http::string_body> parser;
-  parser.body_limit(64u << 20);
-  if (method == http::verb::head) parser.skip(true);
-  http::read(stream, buffer, parser);
-  const auto& res = parser.get();
-  beast::error_code ec;
-  stream.socket().shutdown(tcp::socket::shutdown_both, ec);
-  return {int(res.result_int()), std::string(res[http::field::content_type]), res.body()};
-}
+HttpResult httpRequest(std::uint16_t port, const std::string& target, HttpMethod method = HttpMethod::kGet);
 
 struct WsMessage {
   std::string data;
@@ -54,27 +32,16 @@ struct WsMessage {
 
 class WsClient {
  public:
-  explicit WsClient(std::uint16_t port, const std::string& target = "/ws") : ws_(io_) {
-    beast::get_lowest_layer(ws_).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
-    ws_.handshake("127.0.0.1:" + std::to_string(port), target);
-  }
+  /// Connects and completes the handshake; throws boost::system::system_error when the server refuses it.
+  explicit WsClient(std::uint16_t port, const std::string& target = "/ws");
+  ~WsClient();
+  WsClient(const WsClient&) = delete;
+  WsClient& operator=(const WsClient&) = delete;
+
   /// The next message, or nullopt after `timeout` (then the stream is cancelled: later reads fail) or on
-  /// an error. Asynchronous underneath: Beast's stream timeouts apply to asynchronous operations only.
-  std::optional<WsMessage> read(std::chrono::milliseconds timeout = std::chrono::milliseconds(10000)) {
-    beast::flat_buffer buffer;
-    std::optional<beast::error_code> result;
-    ws_.async_read(buffer, [&](beast::error_code ec, std::size_t) { result = ec; });
-    io_.restart();
-    io_.run_for(timeout);
-    if (!result) {
-      beast::get_lowest_layer(ws_).cancel();
-      io_.restart();
-      io_.run();
-      return std::nullopt;
-    }
-    if (*result) return std::nullopt;
-    return WsMessage{beast::buffers_to_string(buffer.data()), ws_.got_binary()};
-  }
+  /// an error.
+  std::optional<WsMessage> read(std::chrono::milliseconds timeout = std::chrono::milliseconds(10000));
+
   /// Reads until `pred(message)` holds; false after `timeout` without it.
   template <class Pred>
   bool readUntil(Pred pred, std::chrono::milliseconds timeout = std::chrono::milliseconds(10000)) {
@@ -88,18 +55,12 @@ class WsClient {
   }
 
  private:
-  boost::asio::io_context io_;
-  websocket::stream<beast::tcp_stream> ws_;
+  struct Connection;
+  std::unique_ptr<Connection> connection_;
 };
 
 /// Waits until the server has registered `n` WebSocket clients (a client's handshake returns before the
 /// server has added it: what is published in between reaches it only if kept).
-inline bool waitForSessions(const ViewServer& server, std::size_t n) {
-  for (int i = 0; i < 1000; ++i) {
-    if (server.stats().sessions >= n) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return false;
-}
+bool waitForSessions(const ViewServer& server, std::size_t n);
 
 }  // namespace rigcal::view::test

@@ -42,11 +42,11 @@ TEST(ViewServer, ServesItsPageAndAssets) {
   EXPECT_GT(three.body.size(), 100'000u);
   EXPECT_EQ(httpRequest(server.port(), "/OrbitControls.js").status, 200);
   // HEAD: the page's status and type without its body; an unknown path is still 404.
-  const auto head = httpRequest(server.port(), "/", test::http::verb::head);
+  const auto head = httpRequest(server.port(), "/", test::HttpMethod::kHead);
   EXPECT_EQ(head.status, 200);
   EXPECT_NE(head.content_type.find("text/html"), std::string::npos);
   EXPECT_TRUE(head.body.empty());
-  EXPECT_EQ(httpRequest(server.port(), "/etc/passwd", test::http::verb::head).status, 404);
+  EXPECT_EQ(httpRequest(server.port(), "/etc/passwd", test::HttpMethod::kHead).status, 404);
   EXPECT_GE(server.stats().http_requests, 7u);
 }
 
@@ -70,9 +70,9 @@ TEST(ViewServer, RefusesPathsOutsideItsOwnRoutesAndWrites) {
     EXPECT_EQ(r.status, 404) << target;
     EXPECT_EQ(r.body.find("root:"), std::string::npos) << target;
   }
-  EXPECT_EQ(httpRequest(server.port(), "/", test::http::verb::post).status, 405);
-  EXPECT_EQ(httpRequest(server.port(), "/report.json", test::http::verb::put).status, 405);
-  EXPECT_EQ(httpRequest(server.port(), "/", test::http::verb::delete_).status, 405);
+  EXPECT_EQ(httpRequest(server.port(), "/", test::HttpMethod::kPost).status, 405);
+  EXPECT_EQ(httpRequest(server.port(), "/report.json", test::HttpMethod::kPut).status, 405);
+  EXPECT_EQ(httpRequest(server.port(), "/", test::HttpMethod::kDelete).status, 405);
 }
 
 TEST(ViewServer, WebSocketRoundTripAndHistoryForLateClients) {
