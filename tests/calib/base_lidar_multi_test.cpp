@@ -24,9 +24,14 @@ Errors errorsOf(const Pose& estimate, const Pose& truth) {
   return {std::abs(e.z - t.z), rad2deg(std::abs(e.roll - t.roll)), rad2deg(std::abs(e.pitch - t.pitch))};
 }
 
+// Accuracy over a simulated 12 s drive (under ASan its simulation alone took 50 s per test). Under the
+// sanitizers calibrateBaseLidarMulti runs in BaseLidarMulti.NoKeyframeOrNoGroundFailsWithAMessage.
+constexpr const char* kReleaseOnly = "accuracy over a simulated drive: Release only";
+
 class BaseLidarMultiTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
+    if (RIGCAL_SANITIZED) return;  // see kReleaseOnly
     test::SimDatasetOptions o;  // the preset's 4 cm bumps every 5 m and 1.2 % slope
     o.frames = 2;
     o.seconds = 12.0;  // under three bump periods: shorter stretches do not average them out
@@ -34,7 +39,7 @@ class BaseLidarMultiTest : public ::testing::Test {
     const auto& d = data_->datasets.front();
     for (const auto& c : d.mapping_clouds) {
       const Scan& s = *c.cloud;
-      for (std::size_t j = 0; j < s.size(); j += RIGCAL_SANITIZED ? 4 : 1)
+      for (std::size_t j = 0; j < s.size(); ++j)
         map_.push_back(c.frame.T_map_lidar * Eigen::Vector3d(s.x[j], s.y[j], s.z[j]));
     }
     for (const auto& f : d.trajectory)
@@ -56,6 +61,7 @@ std::vector<Eigen::Vector3d> BaseLidarMultiTest::map_;
 std::vector<Pose> BaseLidarMultiTest::keyframes_;
 
 TEST_F(BaseLidarMultiTest, MedianOverKeyframesBeatsOneKeyframeOnBumps) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << kReleaseOnly;
   ASSERT_GE(keyframes_.size(), 6u);
   const Pose truth = data_->truth_T_base_mapping;
   const Pose guess = test::perturb(truth, 0.05, 1.0, 3);
@@ -64,7 +70,7 @@ TEST_F(BaseLidarMultiTest, MedianOverKeyframesBeatsOneKeyframeOnBumps) {
   p.base_lidar_crop_box_min_x = p.base_lidar_crop_box_min_y = p.base_lidar_crop_box_min_z = -20.0;
   p.base_lidar_crop_box_max_x = p.base_lidar_crop_box_max_y = p.base_lidar_crop_box_max_z = 20.0;
   calib::BaseLidarMultiSettings s;
-  s.max_points_per_fit = RIGCAL_SANITIZED ? 8000 : 30000;  // keeps the test short; the command fits more
+  s.max_points_per_fit = 30000;  // keeps the test short; the command fits more
 
   // Every keyframe on its own: the spread the bumps cause.
   Errors worst;
@@ -99,13 +105,13 @@ TEST_F(BaseLidarMultiTest, MedianOverKeyframesBeatsOneKeyframeOnBumps) {
 // footprint fits the plane the wheels rest on, so the bumps drop out of each estimate, not only the median.
 // The default crop box is the default vehicle footprint's (config/vehicle_footprint.hpp): no setting needed.
 TEST_F(BaseLidarMultiTest, DefaultFootprintCropMeetsTheIssueTargets) {
+  if (RIGCAL_SANITIZED) GTEST_SKIP() << kReleaseOnly;
   const Pose truth = data_->truth_T_base_mapping;
   const Pose guess = test::perturb(truth, 0.05, 1.0, 3);
   config::Parameters p = data_->params;
   const config::Parameters defaults;
   ASSERT_EQ(p.base_lidar_crop_box_max_x, defaults.base_lidar_crop_box_max_x) << "the default box is under test";
   ASSERT_LT(p.base_lidar_crop_box_max_x - p.base_lidar_crop_box_min_x, 6.0) << "a footprint, not upstream's ±20 m";
-  if (RIGCAL_SANITIZED) p.base_lidar_min_plane_points = 300;  // the map is thinned 4x there
   const auto all = calib::calibrateBaseLidarMulti(map_, keyframes_, guess, p);
   ASSERT_TRUE(all.ok) << all.failure;
   const Errors e = errorsOf(all.T_base_lidar, truth);
