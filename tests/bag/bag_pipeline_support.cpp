@@ -1,6 +1,5 @@
 #include "bag_pipeline_support.hpp"
 
-#include <fstream>
 #include <regex>
 #include <sstream>
 

@@ -50,8 +50,12 @@ CommandResult compareWithTruth(const std::filesystem::path& sim_dir, const std::
                     "--max-cm", cm.str(), "--max-deg", deg.str()});
 }
 
+std::string presetText(const std::string& name) {
+  return fileContents(std::filesystem::path(RIGCAL_SCENARIOS_DIR) / (name + ".yaml"));
+}
+
 std::string shortenedPreset(const std::string& preset, const std::string& segments, const std::string& parameters) {
-  std::string text = fileContents(std::filesystem::path(RIGCAL_SCENARIOS_DIR) / (preset + ".yaml"));
+  std::string text = presetText(preset);
   const std::size_t params = text.find("  parameters:\n");
   const std::size_t drive = text.find("  segments:\n");
   if (params == std::string::npos || drive == std::string::npos || params > drive) return {};

@@ -30,6 +30,9 @@ std::vector<std::string> calibrateArgs(const std::filesystem::path& sim_dir, con
 CommandResult compareWithTruth(const std::filesystem::path& sim_dir, const std::filesystem::path& out_dir,
                                double max_cm, double max_deg);
 
+/// The text of the simulator preset `name` (sim/scenarios/<name>.yaml).
+std::string presetText(const std::string& name);
+
 /// The preset `preset` of RIGCAL_SCENARIOS_DIR with its drive replaced by `segments` and each line of
 /// `parameters` replacing (or adding) the rig parameter of that name. Empty when the preset's layout is
 /// not as expected.

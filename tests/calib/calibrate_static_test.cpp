@@ -39,10 +39,6 @@ using Clock = std::chrono::steady_clock;
 constexpr double kMaxCm = 1.0;
 constexpr double kMaxDeg = 0.05;
 
-std::string presetText(const std::string& name) {
-  return fileContents(std::filesystem::path(RIGCAL_SCENARIOS_DIR) / (name + ".yaml"));
-}
-
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   EXPECT_NE(at, std::string::npos) << "preset no longer has: " << from;

@@ -11,10 +11,8 @@
 
 #include <atomic>
 #include <chrono>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 #include <thread>
 #include <vector>
 

@@ -3,7 +3,6 @@
 
 #include <cmath>
 #include <fstream>
-#include <sstream>
 
 #include "rigcal/config/rig_config.hpp"
 #include "rigcal/sim/outputs.hpp"

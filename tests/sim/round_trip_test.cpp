@@ -3,10 +3,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include "round_trip_util.hpp"
 #include "sanitizers.hpp"

@@ -2,7 +2,6 @@
 
 #include <fstream>
 #include <numbers>
-#include <sstream>
 
 #include "rigcal/drivers/velodyne/velodyne_calibration.hpp"
 #include "rigcal/drivers/velodyne/velodyne_decoder.hpp"
